@@ -1,0 +1,69 @@
+#pragma once
+/// \file keypoint_tracker.h
+/// Preliminary pose from keypoints (paper Sec. 3.1): Shi-Tomasi corners detected inside the
+/// object's projection on a frame whose pose is known, anchored on the mesh surface through
+/// the renderer's face-index buffer, tracked into the next frame with pyramidal KLT and a
+/// forward-backward check, then PnP + RANSAC.
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "klt_contour_tracker/core/camera.h"
+#include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/renderer.h"
+#include "klt_contour_tracker/core/tracker_params.h"
+
+namespace kct {
+
+/// 2D-3D correspondences that survived RANSAC: the input of the search-area constraint (Sec. 3.4).
+struct KeypointInliers {
+  std::vector<Eigen::Vector3d> points_object;  ///< model points, object frame, metres
+  std::vector<Eigen::Vector2d> points_image;   ///< tracked image positions, px
+};
+
+/// Outcome of tracking the anchored keypoints into a new frame.
+struct KeypointResult {
+  bool success = false;          ///< false: < klt_min_points tracks or inlier rate < klt_min_inlier_ratio
+  Pose object_to_camera = Pose::Identity();  ///< PnP pose (valid only when success)
+  int tracked = 0;               ///< tracks that passed the forward-backward check
+  int inliers = 0;               ///< RANSAC inliers
+  double inlier_ratio = 0.0;     ///< inliers / tracked
+  double mean_reprojection_px = 0.0;  ///< mean reprojection error of the inliers at the PnP pose
+  KeypointInliers inlier_points;      ///< correspondences used by the search area
+};
+
+/// Owns the anchored keypoints between frames.
+class KeypointTracker {
+ public:
+  KeypointTracker(std::shared_ptr<const Mesh> mesh, const TrackerParams& params);
+
+  /// Detects corners in `gray` (CV_8UC1) inside the object's projection at `object_to_camera`
+  /// and anchors them on the mesh. Returns the number of anchored keypoints.
+  int detect(const cv::Mat& gray, const Pose& object_to_camera, const PinholeCamera& camera);
+
+  /// Tracks the anchored keypoints from the previous frame into `gray` and solves PnP from
+  /// `object_to_camera_guess` (used as the RANSAC initial guess). Keeps the inliers.
+  KeypointResult track(const cv::Mat& gray, const Pose& object_to_camera_guess,
+                       const PinholeCamera& camera);
+
+  /// True when the kept points have thinned below `redetect_ratio` of the last detection.
+  bool needs_redetection() const;
+  /// Current image positions (px) of the kept keypoints (for debug drawing).
+  const std::vector<cv::Point2f>& image_points() const { return image_points_; }
+  int num_keypoints() const { return static_cast<int>(image_points_.size()); }
+  void clear();
+  void set_params(const TrackerParams& params) { params_ = params; }
+
+ private:
+  std::shared_ptr<const Mesh> mesh_;
+  Renderer renderer_;
+  TrackerParams params_;
+  cv::Mat previous_gray_;
+  std::vector<cv::Point2f> image_points_;
+  std::vector<cv::Point3f> object_points_;
+  int detected_count_ = 0;
+};
+
+}  // namespace kct

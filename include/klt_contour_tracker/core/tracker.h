@@ -1,0 +1,97 @@
+#pragma once
+/// \file tracker.h
+/// The per-frame pipeline (paper Sec. 3): keypoint pose or extrapolation, then contour-energy
+/// refinement, then re-anchoring of the keypoints from the final pose. The core is pushed
+/// frames: `track()` is called once per image, it owns no thread and does no I/O.
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "klt_contour_tracker/core/camera.h"
+#include "klt_contour_tracker/core/keypoint_tracker.h"
+#include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/tracker_params.h"
+
+namespace kct {
+
+class PoseRefiner;
+
+/// One camera image. 8-bit grey (CV_8UC1) or BGR (CV_8UC3); undistorted unless the camera
+/// given to the tracker has distortion coefficients.
+struct Frame {
+  cv::Mat image;
+  double stamp_s = 0.0;  ///< seconds, only used to detect time going backwards
+};
+
+/// Why a frame's pose is what it is.
+enum class TrackStatus {
+  kNotInitialized,  ///< no pose given yet: nothing to track from
+  kInitialized,     ///< the frame got the pose given to initialize()
+  kKeypoints,       ///< preliminary pose from KLT + PnP
+  kExtrapolated,    ///< KLT failed: preliminary pose extrapolated from the two previous poses
+  kInvalidInput,    ///< empty image, wrong type or size: frame skipped, state unchanged
+};
+const char* to_string(TrackStatus status);
+
+/// Result of one frame. `object_to_camera` is meaningful unless the status is
+/// kNotInitialized or kInvalidInput.
+struct TrackResult {
+  TrackStatus status = TrackStatus::kNotInitialized;
+  Pose object_to_camera = Pose::Identity();
+  Pose preliminary_object_to_camera = Pose::Identity();  ///< before refinement
+  KeypointResult keypoints;       ///< the KLT stage's statistics
+  bool refined = false;           ///< the contour refinement ran
+  double energy_before = 0.0;     ///< contour energy (Eq. 5) at the preliminary pose, frame unblurred
+  double energy_after = 0.0;      ///< contour energy at the final pose, frame unblurred
+  int hops = 0;                   ///< basin-hopping hops run (all stages)
+  double frame_time_ms = 0.0;     ///< wall time spent in track()
+  std::string message;            ///< human-readable detail for kInvalidInput
+};
+
+/// Tracks one rigid object in one camera's image stream.
+class Tracker {
+ public:
+  /// Throws std::invalid_argument if the parameters do not validate.
+  Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera, const TrackerParams& params);
+  ~Tracker();
+
+  /// The next frame passed to track() has this pose; tracking continues from it.
+  /// Throws std::invalid_argument for a non-finite pose or one with the object behind the camera.
+  void initialize(const Pose& object_to_camera);
+  /// Drops the track; track() returns kNotInitialized until initialize() is called again.
+  void reset();
+  bool is_initialized() const { return state_ != State::kWaiting; }
+
+  /// Runs the pipeline on one frame.
+  TrackResult track(const Frame& frame);
+
+  /// Changes the intrinsics (e.g. a new camera_info); keeps the track.
+  void set_camera(const PinholeCamera& camera);
+  const PinholeCamera& camera() const { return camera_; }
+  /// Replaces the parameters (validated; throws std::invalid_argument); keeps the track.
+  void set_params(const TrackerParams& params);
+  const TrackerParams& params() const { return params_; }
+  const Mesh& mesh() const { return *mesh_; }
+  /// Last pose output (valid when is_initialized()).
+  const Pose& last_pose() const { return pose_i1_; }
+
+ private:
+  enum class State { kWaiting, kPendingFirstFrame, kTracking };
+  cv::Mat to_gray(const cv::Mat& image) const;
+
+  std::shared_ptr<const Mesh> mesh_;
+  PinholeCamera camera_;
+  TrackerParams params_;
+  KeypointTracker keypoints_;
+  std::unique_ptr<PoseRefiner> refiner_;
+  cv::Mat undistort_map_x_, undistort_map_y_;
+  State state_ = State::kWaiting;
+  Pose pose_i1_ = Pose::Identity();  ///< pose of the previous frame
+  Pose pose_i2_ = Pose::Identity();  ///< pose of the frame before
+  int frames_since_init_ = 0;
+  int frames_since_detection_ = 0;
+};
+
+}  // namespace kct

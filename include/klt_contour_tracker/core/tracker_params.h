@@ -1,0 +1,65 @@
+#pragma once
+/// \file tracker_params.h
+/// Every tunable of the tracker in one struct. Defaults are the paper's values (Sec. 3 and the
+/// supplement, "Implementation Settings"); values the paper does not give are marked "ours".
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace kct {
+
+/// Parameters of the whole per-frame pipeline.
+struct TrackerParams {
+  // ---- Keypoints: Shi-Tomasi detection, pyramidal KLT, PnP + RANSAC (Sec. 3.1) -------------
+  int max_keypoints = 400;                 ///< ours: corners detected inside the object mask
+  double corner_quality_level = 0.01;      ///< ours: Shi-Tomasi quality relative to the best
+  double corner_min_distance_px = 6.0;     ///< ours: minimum distance between corners, px
+  int klt_window_px = 21;                  ///< ours: LK window side, px (odd)
+  int klt_pyramid_levels = 3;              ///< ours: LK pyramid levels above the base
+  double klt_forward_backward_px = 1.0;    ///< ours: max forward-backward error of a track, px
+  double ransac_reprojection_px = 3.0;     ///< ours: RANSAC inlier threshold, px
+  int ransac_iterations = 200;             ///< ours: RANSAC iterations
+  int klt_min_points = 8;                  ///< paper: KLT fails below this many tracked points
+  double klt_min_inlier_ratio = 0.3;       ///< paper: KLT fails below this RANSAC inlier rate
+  /// ours: re-detect keypoints from the newest pose when the tracked inliers fall below this
+  /// fraction of the count at the last detection.
+  double redetect_ratio = 0.6;
+  /// ours: also re-detect every N frames (0 = only when the points thin out).
+  int redetect_interval_frames = 0;
+
+  // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
+  bool refine = true;                      ///< false = the `klt_only` baseline
+  double sharp_edge_angle_deg = 45.0;      ///< paper: alpha, angle criterion for sharp edges
+  int icosphere_subdivisions = 4;          ///< paper: 4 -> 2562 viewpoint directions
+  int visibility_resolution_px = 256;      ///< ours: orthographic render size per viewpoint
+  std::string visibility_cache_dir;        ///< ours: "" = no disk cache
+  double contour_sample_spacing_px = 2.0;  ///< ours: spacing of energy points on the contour
+  double blur_sigma_px = 1.1;              ///< paper: Gaussian sigma before the main optimization
+  int final_hops = 5;                      ///< paper: hops of the last run on the unblurred frame
+  double hops_budget = 25000.0;            ///< paper: s = max{1, budget / (|V| + |F|)}
+  int min_hops_cap = 100;                  ///< paper: min hops = min{10 s, cap}
+  int max_hops_without_improvement_cap = 30;  ///< paper: stop = min{5 s, cap}
+  int max_hops_cap = 200;                  ///< paper: max hops = min{30 s, cap}
+  double max_reprojection_increase_px = 2.5;  ///< paper: E_max, search area when KLT succeeded
+  double extrapolated_rotation_bound_deg = 30.0;   ///< paper: +-Euler angles when extrapolated
+  double extrapolated_axial_bound = 0.2;   ///< paper: +- along the camera axis, x object size
+  double extrapolated_lateral_bound = 0.1; ///< paper: +- along the other axes, x object size
+  double hop_rotation_deg = 4.0;           ///< ours: standard deviation of a hop's rotation
+  double hop_translation = 0.02;           ///< ours: std. dev. of a hop's translation, x size
+  double metropolis_temperature = 0.02;    ///< ours: Metropolis T, relative to the energy
+  int slsqp_max_evaluations = 60;          ///< ours: energy evaluations per local optimization
+  std::uint32_t random_seed = 1;           ///< ours: seed of the hop generator (reproducible)
+
+  /// Throws std::invalid_argument naming the first bad field and its allowed range.
+  void validate() const;
+};
+
+/// Names accepted by make_preset().
+std::vector<std::string> preset_names();
+
+/// "paper": the paper's values (the defaults). "klt_only": paper without refinement.
+/// Throws std::invalid_argument for an unknown name, listing the known ones.
+TrackerParams make_preset(const std::string& name);
+
+}  // namespace kct
