@@ -3,6 +3,7 @@
 /// Triangle mesh of the tracked object, in the object frame, in metres.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
