@@ -1,0 +1,52 @@
+#pragma once
+/// \file param_loader.h
+/// Every ROS parameter of the tracker nodelet, read in one place from the private node handle,
+/// validated, and printable for the start-up echo. The tracker's tunables start from the preset
+/// `~preset`; any `~<TrackerParams field name>` overrides the preset's value.
+
+#include <ros/node_handle.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/tracker_params.h"
+
+namespace klt_contour_tracker {
+
+/// Invalid configuration; what() starts with the parameter's name ("~mesh_scale: ...").
+class ConfigError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// The nodelet's configuration (see config/tracker.yaml for every parameter and its unit).
+struct NodeletConfig {
+  std::string mesh_resource;           ///< ~mesh_resource: package://, file:// or a plain path
+  double mesh_scale = 1.0;             ///< ~mesh_scale: model units -> metres
+  kct::Pose initial_pose = kct::Pose::Identity();  ///< ~initial_pose: object_to_camera, metres
+  std::string object_frame = "object";  ///< ~object_frame: child frame of the published tf
+  std::string preset = "paper";        ///< ~preset: kct::make_preset() name
+  int queue_size = 1;                  ///< ~queue_size: image/camera_info subscriber queue
+  std::string image_transport = "raw";  ///< ~image_transport: image_transport plugin name
+  kct::TrackerParams params;           ///< preset + ~<field> overrides, validated
+};
+
+/// Reads and validates every parameter. Throws ConfigError naming the parameter and the reason
+/// (missing required value, wrong type, out of range, non-finite pose, object behind the camera).
+NodeletConfig load_config(const ros::NodeHandle& private_nh);
+
+/// Private parameters that no part of the nodelet reads (typos), as "~name".
+std::vector<std::string> unknown_parameters(const ros::NodeHandle& private_nh);
+
+/// Multi-line "name: value" listing of the whole configuration, for the start-up echo.
+std::string describe(const NodeletConfig& config);
+
+/// Local file for a mesh resource: file:// URLs and plain paths are returned as paths and
+/// package:// URLs are resolved through the package path, so that assimp finds textures next to
+/// the model; any other URL is fetched with resource_retriever into a temporary file with the
+/// same extension. Throws ConfigError ("~mesh_resource: ...") when it cannot be resolved.
+std::string resolve_mesh_resource(const std::string& resource);
+
+}  // namespace klt_contour_tracker

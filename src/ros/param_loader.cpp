@@ -1,0 +1,256 @@
+#include "klt_contour_tracker/ros/param_loader.h"
+
+#include <resource_retriever/retriever.h>
+#include <ros/names.h>
+#include <ros/package.h>
+#include <ros/param.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+
+namespace klt_contour_tracker {
+namespace {
+
+// Every kct::TrackerParams field; the ROS parameter name is the field name. Keep in sync with
+// tracker_params.h (a field missing here can only be set through the preset).
+#define KCT_TRACKER_PARAM_FIELDS(X)                                                            \
+  X(max_keypoints) X(corner_quality_level) X(corner_min_distance_px) X(klt_window_px)          \
+  X(klt_pyramid_levels) X(klt_forward_backward_px) X(ransac_reprojection_px)                   \
+  X(ransac_iterations) X(klt_min_points) X(klt_min_inlier_ratio) X(redetect_ratio)             \
+  X(redetect_interval_frames) X(refine) X(sharp_edge_angle_deg) X(icosphere_subdivisions)      \
+  X(visibility_resolution_px) X(visibility_cache_dir) X(contour_sample_spacing_px)             \
+  X(blur_sigma_px) X(final_hops) X(hops_budget) X(min_hops_cap)                                \
+  X(max_hops_without_improvement_cap) X(max_hops_cap) X(max_reprojection_increase_px)          \
+  X(extrapolated_rotation_bound_deg) X(extrapolated_axial_bound) X(extrapolated_lateral_bound) \
+  X(hop_rotation_deg) X(hop_translation) X(metropolis_temperature) X(slsqp_max_evaluations)    \
+  X(random_seed)
+
+const char* const kNodeParams[] = {"mesh_resource", "mesh_scale", "initial_pose/position",
+                                   "initial_pose/orientation", "object_frame", "preset",
+                                   "queue_size", "image_transport"};
+
+const char* type_name(XmlRpc::XmlRpcValue::Type type) {
+  switch (type) {
+    case XmlRpc::XmlRpcValue::TypeBoolean: return "a boolean";
+    case XmlRpc::XmlRpcValue::TypeInt: return "an integer";
+    case XmlRpc::XmlRpcValue::TypeDouble: return "a number";
+    case XmlRpc::XmlRpcValue::TypeString: return "a string";
+    case XmlRpc::XmlRpcValue::TypeArray: return "a list";
+    case XmlRpc::XmlRpcValue::TypeStruct: return "a dictionary";
+    default: return "of another type";
+  }
+}
+
+[[noreturn]] void fail(const std::string& name, const std::string& reason) {
+  throw ConfigError("~" + name + ": " + reason);
+}
+
+void wrong_type(const std::string& name, const char* expected, const XmlRpc::XmlRpcValue& v) {
+  fail(name, std::string("must be ") + expected + ", got " +
+                 type_name(const_cast<XmlRpc::XmlRpcValue&>(v).getType()));
+}
+
+// Overloads by field type. Each returns false (value untouched) when the parameter is not set.
+bool read(const ros::NodeHandle& nh, const std::string& name, double& out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return false;
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) out = static_cast<double>(v);
+  else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) out = static_cast<int>(v);
+  else wrong_type(name, "a number", v);
+  return true;
+}
+
+bool read(const ros::NodeHandle& nh, const std::string& name, int& out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return false;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) wrong_type(name, "an integer", v);
+  out = static_cast<int>(v);
+  return true;
+}
+
+bool read(const ros::NodeHandle& nh, const std::string& name, std::uint32_t& out) {
+  int value = 0;
+  if (!read(nh, name, value)) return false;
+  if (value < 0) fail(name, "must be >= 0, got " + std::to_string(value));
+  out = static_cast<std::uint32_t>(value);
+  return true;
+}
+
+bool read(const ros::NodeHandle& nh, const std::string& name, bool& out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return false;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) wrong_type(name, "a boolean", v);
+  out = static_cast<bool>(v);
+  return true;
+}
+
+bool read(const ros::NodeHandle& nh, const std::string& name, std::string& out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return false;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeString) wrong_type(name, "a string", v);
+  out = static_cast<std::string>(v);
+  return true;
+}
+
+std::vector<double> read_vector(const ros::NodeHandle& nh, const std::string& name,
+                                std::size_t size) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) fail(name, "is required (a list of " + std::to_string(size) + " numbers)");
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeArray || static_cast<std::size_t>(v.size()) != size)
+    fail(name, "must be a list of " + std::to_string(size) + " numbers");
+  std::vector<double> out(size);
+  for (std::size_t i = 0; i < size; ++i) {
+    XmlRpc::XmlRpcValue& e = v[static_cast<int>(i)];
+    if (e.getType() == XmlRpc::XmlRpcValue::TypeDouble) out[i] = static_cast<double>(e);
+    else if (e.getType() == XmlRpc::XmlRpcValue::TypeInt) out[i] = static_cast<int>(e);
+    else fail(name, "entry " + std::to_string(i) + " is not a number");
+    if (!std::isfinite(out[i])) fail(name, "entry " + std::to_string(i) + " is not finite");
+  }
+  return out;
+}
+
+kct::Pose read_initial_pose(const ros::NodeHandle& nh) {
+  const std::vector<double> p = read_vector(nh, "initial_pose/position", 3);
+  const std::vector<double> q = read_vector(nh, "initial_pose/orientation", 4);
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (std::abs(norm - 1.0) > 1e-2)
+    fail("initial_pose/orientation",
+         "must be a unit quaternion x y z w (norm " + std::to_string(norm) + ")");
+  if (p[2] <= 0.0)
+    fail("initial_pose/position",
+         "z = " + std::to_string(p[2]) +
+             " m puts the object behind the camera (object_to_camera, optical frame: z forward)");
+  return kct::pose_from_quaternion(p[0], p[1], p[2], q[0], q[1], q[2], q[3]);
+}
+
+std::string format(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+std::string format(int v) { return std::to_string(v); }
+std::string format(std::uint32_t v) { return std::to_string(v); }
+std::string format(bool v) { return v ? "true" : "false"; }
+std::string format(const std::string& v) { return "'" + v + "'"; }
+
+}  // namespace
+
+NodeletConfig load_config(const ros::NodeHandle& nh) {
+  NodeletConfig config;
+  if (!read(nh, "mesh_resource", config.mesh_resource) || config.mesh_resource.empty())
+    fail("mesh_resource", "is required (package://, file:// or a path to a mesh file)");
+  read(nh, "mesh_scale", config.mesh_scale);
+  if (!(config.mesh_scale > 0.0) || !std::isfinite(config.mesh_scale))
+    fail("mesh_scale", "must be a positive finite number, got " + format(config.mesh_scale));
+  config.initial_pose = read_initial_pose(nh);
+  read(nh, "object_frame", config.object_frame);
+  if (config.object_frame.empty()) fail("object_frame", "must not be empty");
+  read(nh, "queue_size", config.queue_size);
+  if (config.queue_size < 1)
+    fail("queue_size", "must be >= 1, got " + std::to_string(config.queue_size));
+  read(nh, "image_transport", config.image_transport);
+
+  read(nh, "preset", config.preset);
+  try {
+    config.params = kct::make_preset(config.preset);
+  } catch (const std::invalid_argument& e) {
+    fail("preset", e.what());
+  }
+#define KCT_READ_FIELD(field) read(nh, #field, config.params.field);
+  KCT_TRACKER_PARAM_FIELDS(KCT_READ_FIELD)
+#undef KCT_READ_FIELD
+  try {
+    config.params.validate();
+  } catch (const std::invalid_argument& e) {
+    // validate() says "TrackerParams.<field> ..."; name the ROS parameter instead.
+    std::string what = e.what();
+    const std::string prefix = "TrackerParams.";
+    if (what.rfind(prefix, 0) == 0) what = "~" + what.substr(prefix.size());
+    throw ConfigError(what);
+  }
+  return config;
+}
+
+std::vector<std::string> unknown_parameters(const ros::NodeHandle& nh) {
+  std::set<std::string> known(std::begin(kNodeParams), std::end(kNodeParams));
+#define KCT_KNOWN_FIELD(field) known.insert(#field);
+  KCT_TRACKER_PARAM_FIELDS(KCT_KNOWN_FIELD)
+#undef KCT_KNOWN_FIELD
+  std::vector<std::string> all;
+  std::vector<std::string> unknown;
+  if (!ros::param::getParamNames(all)) return unknown;
+  const std::string prefix = nh.getNamespace() + "/";
+  for (const std::string& name : all) {
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string relative = name.substr(prefix.size());
+    if (!known.count(relative)) unknown.push_back("~" + relative);
+  }
+  return unknown;
+}
+
+std::string describe(const NodeletConfig& c) {
+  std::ostringstream s;
+  const Eigen::Quaterniond q(c.initial_pose.rotation());
+  const Eigen::Vector3d t = c.initial_pose.translation();
+  s << "  mesh_resource: " << format(c.mesh_resource) << "\n"
+    << "  mesh_scale: " << c.mesh_scale << "\n"
+    << "  initial_pose/position: [" << t.x() << ", " << t.y() << ", " << t.z() << "]  # m\n"
+    << "  initial_pose/orientation: [" << q.x() << ", " << q.y() << ", " << q.z() << ", "
+    << q.w() << "]  # x y z w\n"
+    << "  object_frame: " << format(c.object_frame) << "\n"
+    << "  queue_size: " << c.queue_size << "\n"
+    << "  image_transport: " << format(c.image_transport) << "\n"
+    << "  preset: " << format(c.preset) << "\n";
+#define KCT_DESCRIBE_FIELD(field) s << "  " #field ": " << format(c.params.field) << "\n";
+  KCT_TRACKER_PARAM_FIELDS(KCT_DESCRIBE_FIELD)
+#undef KCT_DESCRIBE_FIELD
+  std::string out = s.str();
+  if (!out.empty()) out.pop_back();
+  return out;
+}
+
+std::string resolve_mesh_resource(const std::string& resource) {
+  const std::string file_scheme = "file://";
+  const std::string package_scheme = "package://";
+  if (resource.rfind(file_scheme, 0) == 0) return resource.substr(file_scheme.size());
+  if (resource.find("://") == std::string::npos) return resource;
+  if (resource.rfind(package_scheme, 0) == 0) {
+    const std::string rest = resource.substr(package_scheme.size());
+    const std::size_t slash = rest.find('/');
+    const std::string package = rest.substr(0, slash);
+    const std::string package_path = ros::package::getPath(package);
+    if (package_path.empty()) fail("mesh_resource", "package '" + package + "' not found");
+    return slash == std::string::npos ? package_path : package_path + rest.substr(slash);
+  }
+  // Remote resource (http://...): fetch it into a temporary file assimp can open.
+  resource_retriever::MemoryResource memory;
+  try {
+    resource_retriever::Retriever retriever;
+    memory = retriever.get(resource);
+  } catch (const resource_retriever::Exception& e) {
+    fail("mesh_resource", std::string("cannot retrieve: ") + e.what());
+  }
+  const std::size_t dot = resource.find_last_of('.');
+  const std::string extension =
+      dot == std::string::npos || resource.find('/', dot) != std::string::npos ? ""
+                                                                               : resource.substr(dot);
+  std::string path_template = "/tmp/klt_contour_tracker_meshXXXXXX" + extension;
+  std::vector<char> buffer(path_template.begin(), path_template.end());
+  buffer.push_back('\0');
+  const int fd = mkstemps(buffer.data(), static_cast<int>(extension.size()));
+  if (fd < 0) fail("mesh_resource", "cannot create a temporary file for the download");
+  const bool written =
+      write(fd, memory.data.get(), memory.size) == static_cast<ssize_t>(memory.size);
+  close(fd);
+  if (!written) fail("mesh_resource", "cannot write the downloaded mesh to a temporary file");
+  return std::string(buffer.data());
+}
+
+}  // namespace klt_contour_tracker
