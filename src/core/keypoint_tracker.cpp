@@ -1,0 +1,185 @@
+#include "klt_contour_tracker/core/keypoint_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+namespace kct {
+namespace {
+
+// Erosion of the object mask before corner detection, px: corners on the silhouette mostly
+// belong to the background and would be anchored on the wrong surface.
+constexpr int kMaskErosionPx = 3;
+
+Pose pose_from_rvec_tvec(const cv::Mat& rvec, const cv::Mat& tvec) {
+  cv::Mat rotation;
+  cv::Rodrigues(rvec, rotation);
+  Eigen::Matrix3d r;
+  cv::cv2eigen(rotation, r);
+  Pose pose = Pose::Identity();
+  pose.linear() = r;
+  pose.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  return pose;
+}
+
+void pose_to_rvec_tvec(const Pose& pose, cv::Mat& rvec, cv::Mat& tvec) {
+  cv::Mat rotation;
+  cv::eigen2cv(Eigen::Matrix3d(pose.linear()), rotation);
+  cv::Rodrigues(rotation, rvec);
+  tvec = (cv::Mat_<double>(3, 1) << pose.translation().x(), pose.translation().y(),
+          pose.translation().z());
+}
+
+}  // namespace
+
+KeypointTracker::KeypointTracker(std::shared_ptr<const Mesh> mesh, const TrackerParams& params)
+    : mesh_(mesh), renderer_(mesh), params_(params) {}
+
+void KeypointTracker::clear() {
+  previous_gray_.release();
+  image_points_.clear();
+  object_points_.clear();
+  detected_count_ = 0;
+}
+
+int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
+                            const PinholeCamera& camera) {
+  clear();
+  RenderOptions options;
+  options.draw_color = false;
+  const RenderOutput render = renderer_.render(object_to_camera, camera, options);
+  cv::Mat mask = render.mask();
+  cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                                  {2 * kMaskErosionPx + 1, 2 * kMaskErosionPx + 1}));
+  previous_gray_ = gray.clone();
+  if (cv::countNonZero(mask) == 0) return 0;
+
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(gray, corners, params_.max_keypoints, params_.corner_quality_level,
+                          params_.corner_min_distance_px, mask);
+
+  // Anchor each corner on the mesh: intersect its camera ray with the plane of the face the
+  // face-index buffer shows there (exact on the triangle, unlike the rasterized depth).
+  const Pose camera_to_object = object_to_camera.inverse();
+  const Mesh& mesh = *mesh_;
+  for (const cv::Point2f& corner : corners) {
+    const int u = static_cast<int>(std::lround(corner.x));
+    const int v = static_cast<int>(std::lround(corner.y));
+    if (u < 0 || v < 0 || u >= render.face_index.cols || v >= render.face_index.rows) continue;
+    const int face = render.face_index.at<int>(v, u);
+    if (face < 0) continue;
+    const Eigen::Vector3i& f = mesh.faces[face];
+    const Eigen::Vector3d p0 = object_to_camera * mesh.vertices[f[0]];
+    const Eigen::Vector3d normal =
+        object_to_camera.linear() * mesh.face_normal(face);
+    const Eigen::Vector3d ray = camera.back_project({corner.x, corner.y});
+    const double denominator = normal.dot(ray);
+    if (std::abs(denominator) < 1e-9) continue;  // ray grazes the face
+    const double depth = normal.dot(p0) / denominator;
+    if (!(depth > 0) || !std::isfinite(depth)) continue;
+    const Eigen::Vector3d point_object = camera_to_object * (depth * ray);
+    image_points_.push_back(corner);
+    object_points_.emplace_back(static_cast<float>(point_object.x()),
+                                static_cast<float>(point_object.y()),
+                                static_cast<float>(point_object.z()));
+  }
+  detected_count_ = static_cast<int>(image_points_.size());
+  return detected_count_;
+}
+
+bool KeypointTracker::needs_redetection() const {
+  return detected_count_ == 0 ||
+         static_cast<double>(image_points_.size()) < params_.redetect_ratio * detected_count_;
+}
+
+KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to_camera_guess,
+                                      const PinholeCamera& camera) {
+  KeypointResult result;
+  if (image_points_.empty() || previous_gray_.empty() || previous_gray_.size() != gray.size()) {
+    previous_gray_ = gray.clone();
+    image_points_.clear();
+    object_points_.clear();
+    return result;
+  }
+
+  // Pyramidal Lucas-Kanade forward, then backward: a track is kept when it returns to
+  // within klt_forward_backward_px of where it started.
+  const cv::Size window(params_.klt_window_px, params_.klt_window_px);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  std::vector<cv::Mat> previous_pyramid, current_pyramid;
+  cv::buildOpticalFlowPyramid(previous_gray_, previous_pyramid, window, params_.klt_pyramid_levels);
+  cv::buildOpticalFlowPyramid(gray, current_pyramid, window, params_.klt_pyramid_levels);
+  std::vector<cv::Point2f> forward, backward;
+  std::vector<uchar> status_forward, status_backward;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(previous_pyramid, current_pyramid, image_points_, forward,
+                           status_forward, error, window, params_.klt_pyramid_levels, criteria);
+  backward = image_points_;
+  cv::calcOpticalFlowPyrLK(current_pyramid, previous_pyramid, forward, backward, status_backward,
+                           error, window, params_.klt_pyramid_levels, criteria,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+
+  std::vector<cv::Point2f> tracked_image;
+  std::vector<cv::Point3f> tracked_object;
+  const double fb_limit_sq = params_.klt_forward_backward_px * params_.klt_forward_backward_px;
+  for (size_t i = 0; i < image_points_.size(); ++i) {
+    if (!status_forward[i] || !status_backward[i]) continue;
+    const cv::Point2f d = backward[i] - image_points_[i];
+    if (d.dot(d) > fb_limit_sq) continue;
+    if (!camera.in_image({forward[i].x, forward[i].y})) continue;
+    tracked_image.push_back(forward[i]);
+    tracked_object.push_back(object_points_[i]);
+  }
+  previous_gray_ = gray.clone();
+  image_points_ = tracked_image;
+  object_points_ = tracked_object;
+  result.tracked = static_cast<int>(tracked_image.size());
+  if (result.tracked < std::max(params_.klt_min_points, 4)) return result;
+
+  cv::Mat rvec, tvec;
+  pose_to_rvec_tvec(object_to_camera_guess, rvec, tvec);
+  std::vector<int> inliers;
+  const bool solved = cv::solvePnPRansac(
+      tracked_object, tracked_image, camera.K(), cv::noArray(), rvec, tvec,
+      /*useExtrinsicGuess=*/true, params_.ransac_iterations,
+      static_cast<float>(params_.ransac_reprojection_px), 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
+  if (!solved || inliers.size() < 4) return result;
+
+  std::vector<cv::Point2f> inlier_image;
+  std::vector<cv::Point3f> inlier_object;
+  for (int i : inliers) {
+    inlier_image.push_back(tracked_image[i]);
+    inlier_object.push_back(tracked_object[i]);
+  }
+  // Levenberg-Marquardt on all inliers (RANSAC's estimate comes from its best subset).
+  cv::solvePnPRefineLM(inlier_object, inlier_image, camera.K(), cv::noArray(), rvec, tvec);
+  const Pose pose = pose_from_rvec_tvec(rvec, tvec);
+
+  result.inliers = static_cast<int>(inliers.size());
+  result.inlier_ratio = static_cast<double>(result.inliers) / result.tracked;
+  double error_sum = 0.0;
+  for (size_t i = 0; i < inlier_image.size(); ++i) {
+    const Eigen::Vector3d p(inlier_object[i].x, inlier_object[i].y, inlier_object[i].z);
+    const Eigen::Vector2d uv = camera.project(pose * p);
+    const Eigen::Vector2d observed(inlier_image[i].x, inlier_image[i].y);
+    error_sum += (uv - observed).norm();
+    result.inlier_points.points_object.push_back(p);
+    result.inlier_points.points_image.push_back(observed);
+  }
+  result.mean_reprojection_px = error_sum / inlier_image.size();
+
+  const bool pose_ok = is_valid_pose(pose) && pose.translation().z() > 0;
+  result.success = pose_ok && result.inlier_ratio >= params_.klt_min_inlier_ratio;
+  if (result.success) {
+    result.object_to_camera = pose;
+    // Outliers are dropped so they do not pollute the next frame's RANSAC.
+    image_points_ = inlier_image;
+    object_points_ = inlier_object;
+  }
+  return result;
+}
+
+}  // namespace kct

@@ -1,0 +1,173 @@
+#include "klt_contour_tracker/core/tracker.h"
+
+#include <chrono>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#define KCT_NO_REFINER_YET 1
+namespace kct { class PoseRefiner {}; }
+
+namespace kct {
+
+const char* to_string(TrackStatus status) {
+  switch (status) {
+    case TrackStatus::kNotInitialized: return "not_initialized";
+    case TrackStatus::kInitialized: return "initialized";
+    case TrackStatus::kKeypoints: return "keypoints";
+    case TrackStatus::kExtrapolated: return "extrapolated";
+    case TrackStatus::kInvalidInput: return "invalid_input";
+  }
+  return "unknown";
+}
+
+Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
+                 const TrackerParams& params)
+    : mesh_(std::move(mesh)), params_(params), keypoints_(mesh_, params) {
+  if (!mesh_ || mesh_->faces.empty()) throw std::invalid_argument("Tracker: empty mesh");
+  params_.validate();
+  set_camera(camera);
+#ifndef KCT_NO_REFINER_YET
+  if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
+#endif
+}
+
+Tracker::~Tracker() = default;
+
+void Tracker::set_camera(const PinholeCamera& camera) {
+  if (camera.width() <= 0 || camera.height() <= 0)
+    throw std::invalid_argument("Tracker: camera has no image size");
+  camera_ = camera;
+  undistort_map_x_.release();
+  undistort_map_y_.release();
+  if (camera.has_distortion()) {
+    // Frames are undistorted once with the same K, then everything uses the ideal pinhole.
+    cv::initUndistortRectifyMap(camera.K(), camera.distortion(), cv::noArray(), camera.K(),
+                                camera.size(), CV_32FC1, undistort_map_x_, undistort_map_y_);
+  }
+}
+
+void Tracker::set_params(const TrackerParams& params) {
+  params.validate();
+  params_ = params;
+  keypoints_.set_params(params_);
+#ifndef KCT_NO_REFINER_YET
+  if (params_.refine && !refiner_) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
+  if (refiner_) refiner_->set_params(params_);
+#endif
+}
+
+void Tracker::initialize(const Pose& object_to_camera) {
+  if (!is_valid_pose(object_to_camera))
+    throw std::invalid_argument("Tracker::initialize: pose is not finite or not a rotation");
+  if (object_to_camera.translation().z() <= 0)
+    throw std::invalid_argument("Tracker::initialize: the object is behind the camera (z <= 0)");
+  pose_i1_ = pose_i2_ = object_to_camera;
+  keypoints_.clear();
+  state_ = State::kPendingFirstFrame;
+  frames_since_init_ = 0;
+  frames_since_detection_ = 0;
+}
+
+void Tracker::reset() {
+  keypoints_.clear();
+  state_ = State::kWaiting;
+}
+
+cv::Mat Tracker::to_gray(const cv::Mat& image) const {
+  cv::Mat gray;
+  if (image.channels() == 3)
+    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  else
+    gray = image;
+  if (!undistort_map_x_.empty()) {
+    cv::Mat undistorted;
+    cv::remap(gray, undistorted, undistort_map_x_, undistort_map_y_, cv::INTER_LINEAR);
+    return undistorted;
+  }
+  return gray;
+}
+
+TrackResult Tracker::track(const Frame& frame) {
+  const auto start = std::chrono::steady_clock::now();
+  TrackResult result;
+  auto finish = [&]() {
+    result.frame_time_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  };
+  if (frame.image.empty()) {
+    result.status = TrackStatus::kInvalidInput;
+    result.message = "empty image";
+    return finish();
+  }
+  if (frame.image.depth() != CV_8U || (frame.image.channels() != 1 && frame.image.channels() != 3)) {
+    result.status = TrackStatus::kInvalidInput;
+    result.message = "image must be 8-bit grey or BGR";
+    return finish();
+  }
+  if (frame.image.size() != camera_.size()) {
+    result.status = TrackStatus::kInvalidInput;
+    result.message = "image is " + std::to_string(frame.image.cols) + "x" +
+                     std::to_string(frame.image.rows) + " but the camera is " +
+                     std::to_string(camera_.width()) + "x" + std::to_string(camera_.height());
+    return finish();
+  }
+  if (state_ == State::kWaiting) {
+    result.status = TrackStatus::kNotInitialized;
+    return finish();
+  }
+  const cv::Mat gray = to_gray(frame.image);
+
+  if (state_ == State::kPendingFirstFrame) {
+    keypoints_.detect(gray, pose_i1_, camera_);
+    frames_since_detection_ = 0;
+    state_ = State::kTracking;
+    result.status = TrackStatus::kInitialized;
+    result.object_to_camera = result.preliminary_object_to_camera = pose_i1_;
+    return finish();
+  }
+
+  // Sec. 3.1: preliminary pose from KLT + PnP, or extrapolated when KLT fails.
+  result.keypoints = keypoints_.track(gray, pose_i1_, camera_);
+  if (result.keypoints.success) {
+    result.status = TrackStatus::kKeypoints;
+    result.preliminary_object_to_camera = result.keypoints.object_to_camera;
+  } else {
+    result.status = TrackStatus::kExtrapolated;
+    result.preliminary_object_to_camera = extrapolate_pose(pose_i2_, pose_i1_);
+  }
+  result.object_to_camera = result.preliminary_object_to_camera;
+
+  // Sec. 3.2-3.4: contour energy refinement.
+#ifndef KCT_NO_REFINER_YET
+  if (params_.refine && refiner_) {
+    const RefineResult refined =
+        refiner_->refine(gray, camera_, result.preliminary_object_to_camera,
+                         result.keypoints.success ? &result.keypoints : nullptr);
+    if (is_valid_pose(refined.object_to_camera) && refined.object_to_camera.translation().z() > 0) {
+      result.object_to_camera = refined.object_to_camera;
+      result.refined = true;
+    }
+    result.energy_before = refined.energy_before;
+    result.energy_after = refined.energy_after;
+    result.hops = refined.hops;
+  }
+#endif
+
+  // The frame's final pose seeds the extrapolation and the keypoint re-detection, so that
+  // keypoint drift is corrected by the refinement (paper Fig. 4).
+  pose_i2_ = pose_i1_;
+  pose_i1_ = result.object_to_camera;
+  ++frames_since_init_;
+  ++frames_since_detection_;
+  const bool interval_due = params_.redetect_interval_frames > 0 &&
+                            frames_since_detection_ >= params_.redetect_interval_frames;
+  if (!result.keypoints.success || keypoints_.needs_redetection() || interval_due) {
+    keypoints_.detect(gray, pose_i1_, camera_);
+    frames_since_detection_ = 0;
+  }
+  return finish();
+}
+
+}  // namespace kct
