@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 namespace kct {
 namespace {
@@ -17,7 +19,74 @@ void check_range(const char* name, T value, T lo, T hi) {
   }
 }
 
+// One entry per field: its name and a pointer to it. Keeps set_param() and describe() in
+// step with the struct without a hand-written if-chain per use.
+using Field = std::variant<int TrackerParams::*, double TrackerParams::*, bool TrackerParams::*,
+                           std::string TrackerParams::*, std::uint32_t TrackerParams::*>;
+const std::vector<std::pair<const char*, Field>>& fields() {
+  static const std::vector<std::pair<const char*, Field>> table = {
+#define KCT_FIELD(name) {#name, &TrackerParams::name}
+      KCT_FIELD(max_keypoints), KCT_FIELD(corner_quality_level), KCT_FIELD(corner_min_distance_px),
+      KCT_FIELD(klt_window_px), KCT_FIELD(klt_pyramid_levels), KCT_FIELD(klt_forward_backward_px),
+      KCT_FIELD(ransac_reprojection_px), KCT_FIELD(ransac_iterations), KCT_FIELD(klt_min_points),
+      KCT_FIELD(klt_min_inlier_ratio), KCT_FIELD(redetect_ratio), KCT_FIELD(redetect_interval_frames),
+      KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
+      KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
+      KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
+      KCT_FIELD(hops_budget), KCT_FIELD(min_hops_cap), KCT_FIELD(max_hops_without_improvement_cap),
+      KCT_FIELD(max_hops_cap), KCT_FIELD(max_reprojection_increase_px),
+      KCT_FIELD(extrapolated_rotation_bound_deg), KCT_FIELD(extrapolated_axial_bound),
+      KCT_FIELD(extrapolated_lateral_bound), KCT_FIELD(hop_rotation_deg), KCT_FIELD(hop_translation),
+      KCT_FIELD(metropolis_temperature), KCT_FIELD(slsqp_max_evaluations), KCT_FIELD(random_seed),
+#undef KCT_FIELD
+  };
+  return table;
+}
+
+template <typename T>
+T parse(const std::string& name, const std::string& text) {
+  std::istringstream in(text);
+  T value{};
+  if constexpr (std::is_same_v<T, bool>) {
+    if (text == "true" || text == "1") return true;
+    if (text == "false" || text == "0") return false;
+    throw std::invalid_argument("TrackerParams." + name + ": '" + text + "' is not true/false");
+  } else {
+    in >> value;
+    if (in.fail() || !(in >> std::ws).eof())
+      throw std::invalid_argument("TrackerParams." + name + ": '" + text + "' is not a number");
+  }
+  return value;
+}
+
 }  // namespace
+
+void set_param(TrackerParams& params, const std::string& name, const std::string& value) {
+  for (const auto& [field_name, field] : fields()) {
+    if (name != field_name) continue;
+    std::visit(
+        [&](auto member) {
+          using T = std::decay_t<decltype(params.*member)>;
+          if constexpr (std::is_same_v<T, std::string>)
+            params.*member = value;
+          else
+            params.*member = parse<T>(name, value);
+        },
+        field);
+    return;
+  }
+  throw std::invalid_argument("unknown tracker parameter '" + name + "'");
+}
+
+std::vector<std::pair<std::string, std::string>> describe(const TrackerParams& params) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [field_name, field] : fields()) {
+    std::ostringstream text;
+    std::visit([&](auto member) { text << std::boolalpha << params.*member; }, field);
+    out.emplace_back(field_name, text.str());
+  }
+  return out;
+}
 
 void TrackerParams::validate() const {
   check_range("max_keypoints", max_keypoints, 8, 100000);

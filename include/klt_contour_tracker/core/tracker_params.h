@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kct {
@@ -54,6 +55,14 @@ struct TrackerParams {
   /// Throws std::invalid_argument naming the first bad field and its allowed range.
   void validate() const;
 };
+
+/// Sets the field called `name` (the member's name above) from its text form; the ROS layer
+/// and the tools use it to apply overrides on top of a preset. Throws std::invalid_argument
+/// for an unknown name or a value that does not parse (the result is not validated here).
+void set_param(TrackerParams& params, const std::string& name, const std::string& value);
+
+/// Every field's name and current value as text, in declaration order (for echoing).
+std::vector<std::pair<std::string, std::string>> describe(const TrackerParams& params);
 
 /// Names accepted by make_preset().
 std::vector<std::string> preset_names();

@@ -1,0 +1,79 @@
+// TrackerParams: paper defaults, presets, validation and text overrides.
+#include <gtest/gtest.h>
+
+#include "klt_contour_tracker/core/tracker_params.h"
+
+namespace kct {
+namespace {
+
+TEST(TrackerParams, PaperPresetHoldsThePapersValues) {
+  const TrackerParams p = make_preset("paper");
+  EXPECT_TRUE(p.refine);
+  EXPECT_EQ(p.klt_min_points, 8);
+  EXPECT_DOUBLE_EQ(p.klt_min_inlier_ratio, 0.3);
+  EXPECT_DOUBLE_EQ(p.sharp_edge_angle_deg, 45.0);
+  EXPECT_EQ(p.icosphere_subdivisions, 4);
+  EXPECT_DOUBLE_EQ(p.blur_sigma_px, 1.1);
+  EXPECT_EQ(p.final_hops, 5);
+  EXPECT_DOUBLE_EQ(p.max_reprojection_increase_px, 2.5);
+  EXPECT_DOUBLE_EQ(p.extrapolated_rotation_bound_deg, 30.0);
+  EXPECT_DOUBLE_EQ(p.extrapolated_axial_bound, 0.2);
+  EXPECT_DOUBLE_EQ(p.extrapolated_lateral_bound, 0.1);
+  EXPECT_DOUBLE_EQ(p.hops_budget, 25000.0);
+  EXPECT_EQ(p.min_hops_cap, 100);
+  EXPECT_EQ(p.max_hops_without_improvement_cap, 30);
+  EXPECT_EQ(p.max_hops_cap, 200);
+  EXPECT_NO_THROW(p.validate());
+}
+
+TEST(TrackerParams, KltOnlySkipsTheRefinement) {
+  EXPECT_FALSE(make_preset("klt_only").refine);
+}
+
+TEST(TrackerParams, UnknownPresetNamesTheKnownOnes) {
+  try {
+    make_preset("fastest");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("paper"), std::string::npos);
+  }
+}
+
+TEST(TrackerParams, ValidateNamesTheBadField) {
+  TrackerParams p;
+  p.blur_sigma_px = -1.0;
+  try {
+    p.validate();
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("blur_sigma_px"), std::string::npos);
+  }
+  TrackerParams q;
+  q.klt_window_px = 20;
+  EXPECT_THROW(q.validate(), std::invalid_argument);
+}
+
+TEST(TrackerParams, SetParamParsesEachType) {
+  TrackerParams p;
+  set_param(p, "final_hops", "7");
+  set_param(p, "blur_sigma_px", "0.5");
+  set_param(p, "refine", "false");
+  set_param(p, "visibility_cache_dir", "/tmp/x");
+  set_param(p, "random_seed", "99");
+  EXPECT_EQ(p.final_hops, 7);
+  EXPECT_DOUBLE_EQ(p.blur_sigma_px, 0.5);
+  EXPECT_FALSE(p.refine);
+  EXPECT_EQ(p.visibility_cache_dir, "/tmp/x");
+  EXPECT_EQ(p.random_seed, 99u);
+  EXPECT_THROW(set_param(p, "final_hops", "seven"), std::invalid_argument);
+  EXPECT_THROW(set_param(p, "no_such_field", "1"), std::invalid_argument);
+}
+
+TEST(TrackerParams, DescribeListsEveryFieldOnce) {
+  const auto fields = describe(TrackerParams{});
+  EXPECT_EQ(fields.size(), 33u);
+  EXPECT_EQ(fields.front().first, "max_keypoints");
+}
+
+}  // namespace
+}  // namespace kct
