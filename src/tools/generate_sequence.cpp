@@ -104,7 +104,8 @@ Options parse(int argc, char** argv) {
 /// The photograph scaled to cover the image and centre-cropped; a procedural clutter image
 /// (with a warning) when it cannot be read.
 cv::Mat make_background(const std::string& path, cv::Size size, uint64_t seed) {
-  cv::Mat photo = cv::imread(path, cv::IMREAD_COLOR);
+  cv::Mat photo;
+  if (std::filesystem::is_regular_file(path)) photo = cv::imread(path, cv::IMREAD_COLOR);
   if (!photo.empty()) {
     const double scale = std::max(double(size.width) / photo.cols, double(size.height) / photo.rows);
     cv::Mat scaled;

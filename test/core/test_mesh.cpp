@@ -1,0 +1,190 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "klt_contour_tracker/core/mesh.h"
+
+namespace {
+
+const std::string kDemoModel = std::string(KCT_SOURCE_DIR) + "/models/demo_crate.obj";
+
+/// A fresh temporary folder, removed at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    path_ = std::filesystem::temp_directory_path() /
+            ("kct_test_mesh_" +
+             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Signed volume (divergence theorem); positive when faces are CCW seen from outside.
+double signed_volume(const kct::Mesh& mesh) {
+  double volume = 0.0;
+  for (const auto& f : mesh.faces)
+    volume += mesh.vertices[f[0]].dot(mesh.vertices[f[1]].cross(mesh.vertices[f[2]])) / 6.0;
+  return volume;
+}
+
+/// Unit cube OBJ with 4 corners per face (24 'v' lines) and a UV chart per face, so every
+/// edge is a UV seam: the loader must still merge the positions.
+void write_seamed_cube(const std::string& path) {
+  std::ofstream obj(path);
+  const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                           {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  auto corner = [](int i) {
+    return Eigen::Vector3d(((i & 1) ^ ((i >> 1) & 1)) ? 0.5 : -0.5, (i & 2) ? 0.5 : -0.5,
+                           (i & 4) ? 0.5 : -0.5);
+  };
+  for (const auto& q : quads)
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d p = corner(q[k]);
+      obj << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+    }
+  obj << "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+  for (int f = 0; f < 6; ++f) {
+    const int b = 4 * f + 1;
+    obj << "f " << b << "/1 " << b + 1 << "/2 " << b + 2 << "/3 " << b + 3 << "/4\n";
+  }
+}
+
+}  // namespace
+
+TEST(Mesh, DemoModelIsClosedTexturedAndInMetres) {
+  const kct::Mesh mesh = kct::load_mesh(kDemoModel);
+  EXPECT_EQ(mesh.vertices.size(), 18u);
+  EXPECT_EQ(mesh.faces.size(), 32u);
+  ASSERT_TRUE(mesh.has_texture());
+  EXPECT_EQ(mesh.texture.type(), CV_8UC3);
+  EXPECT_EQ(mesh.corner_uvs.size(), 3 * mesh.faces.size());
+  for (const auto& uv : mesh.corner_uvs) {
+    EXPECT_GE(uv.minCoeff(), 0.0f);
+    EXPECT_LE(uv.maxCoeff(), 1.0f);
+  }
+
+  // Closed 2-manifold: every edge of every face appears in exactly one shared edge.
+  const auto edges = mesh.shared_edges();
+  EXPECT_EQ(edges.size() * 2, mesh.faces.size() * 3);
+  std::map<std::pair<int, int>, int> uses;
+  for (const auto& f : mesh.faces)
+    for (int k = 0; k < 3; ++k)
+      ++uses[{std::min(f[k], f[(k + 1) % 3]), std::max(f[k], f[(k + 1) % 3])}];
+  for (const auto& [edge, count] : uses) EXPECT_EQ(count, 2) << edge.first << "-" << edge.second;
+  for (const auto& e : edges) {
+    for (int face : {e.face0, e.face1}) {
+      const auto& f = mesh.faces[face];
+      EXPECT_TRUE((f.array() == e.v0).any() && (f.array() == e.v1).any());
+    }
+    EXPECT_NE(e.face0, e.face1);
+  }
+
+  // Box 0.12 x 0.08 x 0.06 with a 0.02 chamfer and a 0.04 x 0.04 x 0.025 block on top.
+  EXPECT_NEAR(mesh.diameter(), std::sqrt(0.12 * 0.12 + 0.08 * 0.08 + 0.06 * 0.06), 1e-6);
+  EXPECT_NEAR(signed_volume(mesh), 0.12 * 0.08 * 0.06 - 0.5 * 0.02 * 0.02 * 0.06 + 0.04 * 0.04 * 0.025,
+              1e-9);
+  EXPECT_LT((mesh.bounding_box_center() - Eigen::Vector3d(0, 0, 0.0125)).norm(), 1e-9);
+  for (int f = 0; f < static_cast<int>(mesh.faces.size()); ++f)
+    EXPECT_NEAR(mesh.face_normal(f).norm(), 1.0, 1e-12);
+}
+
+TEST(Mesh, ScaleFactorMultipliesCoordinates) {
+  const kct::Mesh metres = kct::load_mesh(kDemoModel);
+  const kct::Mesh millimetres = kct::load_mesh(kDemoModel, 1000.0);
+  ASSERT_EQ(metres.vertices.size(), millimetres.vertices.size());
+  for (std::size_t i = 0; i < metres.vertices.size(); ++i)
+    EXPECT_LT((1000.0 * metres.vertices[i] - millimetres.vertices[i]).norm(), 1e-6);
+  EXPECT_NEAR(millimetres.diameter(), 1000.0 * metres.diameter(), 1e-6);
+  EXPECT_THROW(kct::load_mesh(kDemoModel, 0.0), std::runtime_error);
+}
+
+TEST(Mesh, MissingAndCorruptFilesThrowNamingThePath) {
+  TempDir dir;
+  const std::string missing = dir.file("does_not_exist.obj");
+  try {
+    kct::load_mesh(missing);
+    FAIL() << "no exception for a missing file";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+  }
+  for (const std::string name : {"corrupt.obj", "corrupt.stl", "corrupt.ply"}) {
+    const std::string corrupt = dir.file(name);
+    std::ofstream(corrupt) << "this is \x01\x02 not a mesh\nf 1 2\n";
+    try {
+      kct::load_mesh(corrupt);
+      FAIL() << "no exception for " << name;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(corrupt), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Mesh, MergesPositionsAcrossUvSeams) {
+  TempDir dir;
+  const std::string path = dir.file("cube.obj");
+  write_seamed_cube(path);
+  const kct::Mesh cube = kct::load_mesh(path, 0.1);
+  EXPECT_EQ(cube.vertices.size(), 8u);
+  EXPECT_EQ(cube.faces.size(), 12u);
+  EXPECT_EQ(cube.shared_edges().size(), 18u);
+  EXPECT_FALSE(cube.has_texture());  // no material / image: UVs are dropped
+  EXPECT_NEAR(signed_volume(cube), 1e-3, 1e-12);
+  EXPECT_NEAR(cube.diameter(), 0.1 * std::sqrt(3.0), 1e-12);
+}
+
+TEST(Mesh, AppendMeshTransformsAndOffsets) {
+  const kct::Mesh crate = kct::load_mesh(kDemoModel);
+  kct::Mesh combined;
+  kct::append_mesh(combined, crate, Eigen::Isometry3d::Identity());
+  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+  shift.translate(Eigen::Vector3d(0.5, 0, 0));
+  kct::append_mesh(combined, crate, shift);
+  ASSERT_EQ(combined.vertices.size(), 2 * crate.vertices.size());
+  ASSERT_EQ(combined.faces.size(), 2 * crate.faces.size());
+  const std::size_t n = crate.vertices.size();
+  for (std::size_t i = 0; i < n; ++i)
+    EXPECT_LT((combined.vertices[n + i] - crate.vertices[i] - Eigen::Vector3d(0.5, 0, 0)).norm(),
+              1e-12);
+  EXPECT_EQ(combined.faces[crate.faces.size()], crate.faces[0] + Eigen::Vector3i::Constant(n));
+  EXPECT_TRUE(combined.has_texture());
+  EXPECT_EQ(combined.texture.cols, 2 * crate.texture.cols);
+  EXPECT_EQ(combined.shared_edges().size(), 2 * crate.shared_edges().size());
+}
+
+TEST(Mesh, DiameterOfLargeMeshes) {
+  // UV sphere (exact diameter 2r) with far more than the brute-force vertex limit.
+  kct::Mesh sphere;
+  const int n_lat = 60, n_lon = 80;
+  const double r = 0.1;
+  for (int i = 0; i <= n_lat; ++i)
+    for (int j = 0; j < n_lon; ++j) {
+      const double th = M_PI * i / n_lat, ph = 2 * M_PI * j / n_lon;
+      sphere.vertices.emplace_back(r * std::sin(th) * std::cos(ph),
+                                   r * std::sin(th) * std::sin(ph), r * std::cos(th));
+    }
+  ASSERT_GT(sphere.vertices.size(), 4000u);
+  EXPECT_LE(sphere.diameter(), 2 * r + 1e-12);
+  EXPECT_GE(sphere.diameter(), 2 * r * 0.998);
+
+  // Elongated point set: the pruned exact search must find the true pair.
+  kct::Mesh rod;
+  for (int i = 0; i < 5000; ++i) {
+    const double t = i / 4999.0;
+    rod.vertices.emplace_back(t, 0.01 * std::sin(37.0 * t), 0.01 * std::cos(91.0 * t));
+  }
+  double exact = 0.0;
+  for (std::size_t i = 0; i < rod.vertices.size(); ++i)
+    for (std::size_t j = i + 1; j < rod.vertices.size(); ++j)
+      exact = std::max(exact, (rod.vertices[i] - rod.vertices[j]).norm());
+  EXPECT_NEAR(rod.diameter(), exact, 1e-12);
+}
