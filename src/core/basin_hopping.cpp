@@ -71,6 +71,7 @@ class ScaledProblem {
   }
 
   Vector6d to_x(const Vector6d& z) const { return z.cwiseProduct(scale_); }
+  Vector6d to_z(const Vector6d& x) const { return x.cwiseQuotient(scale_); }
   Vector6d clip(const Vector6d& z) const { return z.cwiseMax(lower_).cwiseMin(upper_); }
   int evaluations() const { return evaluations_; }
 
@@ -229,14 +230,16 @@ BasinHoppingSettings make_basin_hopping_settings(const TrackerParams& params, co
 OptimizationResult BasinHoppingOptimizer::maximize(const std::function<double(const Pose&)>& energy,
                                                    const PoseParametrization& param,
                                                    const SearchArea& area,
-                                                   const BasinHoppingSettings& settings) const {
+                                                   const BasinHoppingSettings& settings,
+                                                   const Vector6d& start_x) const {
   validate(settings, area);
   ScaledProblem problem(energy, param, area, settings);
   std::mt19937 rng(settings.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
 
-  const Candidate initial = problem.evaluate(problem.clip(Vector6d::Zero()));
+  require(start_x.allFinite(), "start_x must be finite");
+  const Candidate initial = problem.evaluate(problem.clip(problem.to_z(start_x)));
   Candidate current = problem.local_maximize(initial);
   Candidate best = current;
 

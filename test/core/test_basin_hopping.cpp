@@ -61,6 +61,31 @@ TEST_F(BasinHoppingTest, FindsSmoothPeakInsideTheBox) {
   EXPECT_TRUE(area_.box_contains(r.best_x));
 }
 
+TEST_F(BasinHoppingTest, FinalStageFromGivenStartRunsFixedHops) {
+  Vector6d peak_x;
+  peak_x << -4 * kDegToRad, 2 * kDegToRad, 6 * kDegToRad, -0.005, 0.003, 0.008;
+  const Pose peak = param_.apply(peak_x);
+  const auto energy = [&](const Pose& p) { return bump(p, peak, 0.05); };
+  Vector6d start_x = peak_x;
+  start_x(2) += 0.5 * kDegToRad;
+  start_x(3) += 0.001;
+  settings_.min_hops = settings_.max_hops = 5;
+  settings_.max_hops_without_improvement = 1;
+  const OptimizationResult r = optimizer_.maximize(energy, param_, area_, settings_, start_x);
+  EXPECT_EQ(r.hops, 5);
+  EXPECT_NEAR(r.initial_energy, energy(param_.apply(start_x)), 1e-15);
+  EXPECT_LT(rotation_error_deg(r.best_pose, peak), 0.1);
+  EXPECT_LT(translation_error(r.best_pose, peak), 1e-3);
+  // Starting outside the box: the start is clipped onto it.
+  Vector6d outside = Vector6d::Zero();
+  outside(5) = 1.0;
+  settings_.max_hops = 0;
+  const OptimizationResult clipped = optimizer_.maximize(energy, param_, area_, settings_, outside);
+  Vector6d on_box = Vector6d::Zero();
+  on_box(5) = area_.upper(5);
+  EXPECT_NEAR(clipped.initial_energy, energy(param_.apply(on_box)), 1e-15);
+}
+
 TEST_F(BasinHoppingTest, PeakOutsideTheBoxEndsOnTheBox) {
   Vector6d peak_x = Vector6d::Zero();
   peak_x(5) = 0.1;  // 10 cm along the camera axis; the box allows +-4 cm
@@ -240,6 +265,15 @@ TEST_F(BasinHoppingTest, RejectsBadSettings) {
   SearchArea inverted = area_;
   inverted.lower(0) = 1.0;
   EXPECT_THROW(optimizer_.maximize(energy, param_, inverted, settings_), std::invalid_argument);
+}
+
+TEST_F(BasinHoppingTest, EnergyExceptionPropagates) {
+  int calls = 0;
+  const auto failing = [&](const Pose&) -> double {
+    if (++calls == 5) throw std::domain_error("energy failed");
+    return 1.0;
+  };
+  EXPECT_THROW(optimizer_.maximize(failing, param_, area_, settings_), std::domain_error);
 }
 
 TEST(MetropolisTest, Criterion) {

@@ -51,7 +51,7 @@ bool metropolis_accept(double candidate_energy, double current_energy, double re
 struct OptimizationResult {
   Pose best_pose = Pose::Identity();  ///< object_to_camera at best_x
   Vector6d best_x = Vector6d::Zero();  ///< best parameters (rad, m), inside the box
-  double initial_energy = 0.0;        ///< energy at x = 0 (the reference pose)
+  double initial_energy = 0.0;        ///< energy at the start (x = 0: the reference pose)
   double best_energy = 0.0;           ///< energy at best_x
   int hops = 0;                       ///< hops run (the first local optimization not counted)
   int evaluations = 0;                ///< energy evaluations, gradients included
@@ -64,14 +64,18 @@ struct OptimizationResult {
 class BasinHoppingOptimizer {
  public:
   /// Maximizes `energy` over poses param.apply(x), x in `area` (box and optional constraint).
-  /// First a local optimization from x = 0; then each hop perturbs the current point (Gaussian,
-  /// hop std. devs., clipped to the box; re-drawn with smaller steps when it violates the
-  /// constraint), optimizes locally, accepts by the Metropolis criterion and keeps the global
-  /// best. Never returns a feasible point worse than x = 0 when x = 0 is feasible.
-  /// Throws std::invalid_argument for inconsistent settings or a box with lower > upper.
+  /// First a local optimization from `start_x` (clipped to the box; x = 0 is the reference pose);
+  /// then each hop perturbs the current point (Gaussian, hop std. devs., clipped to the box;
+  /// re-drawn with smaller steps when it violates the constraint), optimizes locally, accepts by
+  /// the Metropolis criterion and keeps the global best. Never returns a feasible point worse
+  /// than the start when the start is feasible. For the paper's final stage on the unblurred
+  /// frame, pass the same param and area, start_x = the first stage's best_x and
+  /// min_hops = max_hops = 5. Throws std::invalid_argument for inconsistent settings or a box
+  /// with lower > upper; exceptions thrown by `energy` or the constraint propagate.
   OptimizationResult maximize(const std::function<double(const Pose&)>& energy,
                               const PoseParametrization& param, const SearchArea& area,
-                              const BasinHoppingSettings& settings) const;
+                              const BasinHoppingSettings& settings,
+                              const Vector6d& start_x = Vector6d::Zero()) const;
 };
 
 }  // namespace kct
