@@ -116,9 +116,8 @@ class ScaledProblem {
     opt.set_xtol_rel(1e-10);
     opt.set_maxeval(budget);  // NLopt counts calls; our own counter (gradients included) binds first
 
-    std::vector<double> x(start.z.data(), start.z.data() + 6);
     const Vector6d clipped = clip(start.z);
-    std::copy(clipped.data(), clipped.data() + 6, x.begin());
+    std::vector<double> x(clipped.data(), clipped.data() + 6);
     double value = 0.0;
     try {
       opt.optimize(x, value);
