@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -152,7 +153,7 @@ cv::Mat make_texture(int size_px, uint64_t seed, const std::vector<Chart>& chart
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   std::string output_dir = "models";
   uint64_t seed = 7;
   int texture_size = 1024;
@@ -212,6 +213,7 @@ int main(int argc, char** argv) {
   const double pixels_per_metre = pack(charts, texture_size, 8);
   const cv::Mat texture = make_texture(texture_size, seed, charts);
 
+  std::filesystem::create_directories(output_dir);
   const std::string obj_path = output_dir + "/demo_crate.obj";
   const std::string mtl_path = output_dir + "/demo_crate.mtl";
   const std::string png_path = output_dir + "/demo_crate.png";
@@ -279,4 +281,13 @@ int main(int argc, char** argv) {
             << mesh.diameter() << " m, texture " << texture_size << " px at "
             << pixels_per_metre / 1000.0 << " px/mm\n";
   return edges * 2 == mesh.faces.size() * 3 ? 0 : 1;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "make_demo_model: " << e.what() << "\n";
+    return 1;
+  }
 }
