@@ -92,75 +92,88 @@ bool TrackerNodelet::update_camera(const sensor_msgs::CameraInfo& info) {
 void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image,
                               const sensor_msgs::CameraInfoConstPtr& info) {
   const auto start = std::chrono::steady_clock::now();
+  // A status goes out for every image, also a skipped one (rosbag play --rate-control-topic
+  // paces a bag on it, so a missing status would stall the player).
+  auto status = boost::make_shared<TrackerStatus>();
+  status->header = image->header;
+  status->state = kct::to_string(kct::TrackStatus::kInvalidInput);
+  auto skip = [&](const std::string& reason) {
+    NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", reason.c_str());
+    status->message = reason;
+  };
   try {
-    if (!update_camera(*info)) return;
-    const kct::PinholeCamera& camera = tracker_->camera();
-    if (static_cast<int>(image->width) != camera.width() ||
-        static_cast<int>(image->height) != camera.height()) {
-      NODELET_WARN_THROTTLE(5.0, "skipping frame: image is %ux%u but camera_info says %dx%d",
-                            image->width, image->height, camera.width(), camera.height());
-      return;
+    if (!update_camera(*info)) {
+      status->message = "unusable camera_info";
+    } else if (static_cast<int>(image->width) != tracker_->camera().width() ||
+               static_cast<int>(image->height) != tracker_->camera().height()) {
+      skip("image is " + std::to_string(image->width) + "x" + std::to_string(image->height) +
+           " but camera_info says " + std::to_string(tracker_->camera().width()) + "x" +
+           std::to_string(tracker_->camera().height()));
+    } else {
+      track(image, *status);
     }
-    if (!last_stamp_.isZero() && image->header.stamp < last_stamp_) {
-      NODELET_INFO("image stamp jumped back from %.3f to %.3f s (bag loop?): re-initializing "
-                   "to ~initial_pose",
-                   last_stamp_.toSec(), image->header.stamp.toSec());
-      tracker_->initialize(config_.initial_pose);
-    }
-    last_stamp_ = image->header.stamp;
-
-    kct::Frame frame;
-    try {
-      frame.image = image_for_tracker(image);
-    } catch (const std::exception& e) {
-      NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", e.what());
-      return;
-    }
-    frame.stamp_s = image->header.stamp.toSec();
-    const kct::TrackResult result = tracker_->track(frame);
-
-    const bool has_pose = result.status != kct::TrackStatus::kNotInitialized &&
-                          result.status != kct::TrackStatus::kInvalidInput;
-    if (result.status == kct::TrackStatus::kInvalidInput) {
-      NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", result.message.c_str());
-    } else if (result.status == kct::TrackStatus::kExtrapolated) {
-      NODELET_WARN_THROTTLE(5.0, "keypoint tracking failed (%d tracked, %d inliers): pose "
-                                 "extrapolated before refinement",
-                            result.keypoints.tracked, result.keypoints.inliers);
-    }
-    if (has_pose) {
-      auto pose = boost::make_shared<geometry_msgs::PoseStamped>();
-      pose->header = image->header;
-      pose->pose = to_pose_msg(result.object_to_camera);
-      pose_pub_.publish(pose);
-
-      geometry_msgs::TransformStamped transform;
-      transform.header = image->header;
-      transform.child_frame_id = config_.object_frame;
-      transform.transform = to_transform_msg(result.object_to_camera);
-      tf_broadcaster_->sendTransform(transform);
-    }
-
-    auto status = boost::make_shared<TrackerStatus>();
-    status->header = image->header;
-    status->state = kct::to_string(result.status);
-    status->klt_tracked = result.keypoints.tracked;
-    status->klt_inliers = result.keypoints.inliers;
-    status->extrapolated = result.status == kct::TrackStatus::kExtrapolated;
-    status->refined = result.refined;
-    status->energy_before = result.energy_before;
-    status->energy_after = result.energy_after;
-    status->hops = result.hops;
-    status->track_time_ms = result.frame_time_ms;
-    status->message = result.message;
-    status->frame_time_ms = elapsed_ms(start);
-    status_pub_.publish(status);
-    NODELET_DEBUG("frame %.3f: %s, %d inliers, %.1f ms", image->header.stamp.toSec(),
-                  status->state.c_str(), result.keypoints.inliers, status->frame_time_ms);
   } catch (const std::exception& e) {
     // Nothing may escape a subscriber callback: it would take the whole manager down.
     NODELET_ERROR_THROTTLE(5.0, "frame %.3f failed: %s", image->header.stamp.toSec(), e.what());
+    status->message = e.what();
   }
+  status->frame_time_ms = elapsed_ms(start);
+  status_pub_.publish(status);
+  NODELET_DEBUG("frame %.3f: %s, %d inliers, %.1f ms", image->header.stamp.toSec(),
+                status->state.c_str(), status->klt_inliers, status->frame_time_ms);
+}
+
+void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatus& status) {
+  if (!last_stamp_.isZero() && image->header.stamp < last_stamp_) {
+    NODELET_INFO("image stamp jumped back from %.3f to %.3f s (bag loop?): re-initializing to "
+                 "~initial_pose",
+                 last_stamp_.toSec(), image->header.stamp.toSec());
+    tracker_->initialize(config_.initial_pose);
+  }
+  last_stamp_ = image->header.stamp;
+
+  kct::Frame frame;
+  try {
+    frame.image = image_for_tracker(image);
+  } catch (const std::exception& e) {
+    NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", e.what());
+    status.message = e.what();
+    return;
+  }
+  frame.stamp_s = image->header.stamp.toSec();
+  const kct::TrackResult result = tracker_->track(frame);
+
+  status.state = kct::to_string(result.status);
+  status.klt_tracked = result.keypoints.tracked;
+  status.klt_inliers = result.keypoints.inliers;
+  status.extrapolated = result.status == kct::TrackStatus::kExtrapolated;
+  status.refined = result.refined;
+  status.energy_before = result.energy_before;
+  status.energy_after = result.energy_after;
+  status.hops = result.hops;
+  status.track_time_ms = result.frame_time_ms;
+  status.message = result.message;
+
+  if (result.status == kct::TrackStatus::kInvalidInput) {
+    NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", result.message.c_str());
+    return;
+  }
+  if (result.status == kct::TrackStatus::kNotInitialized) return;
+  if (result.status == kct::TrackStatus::kExtrapolated) {
+    NODELET_WARN_THROTTLE(5.0, "keypoint tracking failed (%d tracked, %d inliers): pose "
+                               "extrapolated before refinement",
+                          result.keypoints.tracked, result.keypoints.inliers);
+  }
+  auto pose = boost::make_shared<geometry_msgs::PoseStamped>();
+  pose->header = image->header;
+  pose->pose = to_pose_msg(result.object_to_camera);
+  pose_pub_.publish(pose);
+
+  geometry_msgs::TransformStamped transform;
+  transform.header = image->header;
+  transform.child_frame_id = config_.object_frame;
+  transform.transform = to_transform_msg(result.object_to_camera);
+  tf_broadcaster_->sendTransform(transform);
 }
 
 }  // namespace klt_contour_tracker

@@ -14,6 +14,7 @@
 
 #include <memory>
 
+#include "klt_contour_tracker/TrackerStatus.h"
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/tracker.h"
 #include "klt_contour_tracker/ros/param_loader.h"
@@ -36,6 +37,9 @@ class TrackerNodelet : public nodelet::Nodelet {
   /// Creates the tracker on the first camera_info and updates its camera when it changes.
   /// Returns false (and logs) when the camera_info is unusable.
   bool update_camera(const sensor_msgs::CameraInfo& info);
+  /// Converts and tracks one image whose size matches the camera; publishes pose and tf, fills
+  /// `status`.
+  void track(const sensor_msgs::ImageConstPtr& image, TrackerStatus& status);
 
   NodeletConfig config_;
   std::shared_ptr<const kct::Mesh> mesh_;
