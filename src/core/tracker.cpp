@@ -5,8 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
-#define KCT_NO_REFINER_YET 1
-namespace kct { class PoseRefiner {}; }
+#include "klt_contour_tracker/core/pose_refiner.h"
 
 namespace kct {
 
@@ -27,9 +26,7 @@ Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
   if (!mesh_ || mesh_->faces.empty()) throw std::invalid_argument("Tracker: empty mesh");
   params_.validate();
   set_camera(camera);
-#ifndef KCT_NO_REFINER_YET
   if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
-#endif
 }
 
 Tracker::~Tracker() = default;
@@ -51,10 +48,8 @@ void Tracker::set_params(const TrackerParams& params) {
   params.validate();
   params_ = params;
   keypoints_.set_params(params_);
-#ifndef KCT_NO_REFINER_YET
   if (params_.refine && !refiner_) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   if (refiner_) refiner_->set_params(params_);
-#endif
 }
 
 void Tracker::initialize(const Pose& object_to_camera) {
@@ -140,7 +135,6 @@ TrackResult Tracker::track(const Frame& frame) {
   result.object_to_camera = result.preliminary_object_to_camera;
 
   // Sec. 3.2-3.4: contour energy refinement.
-#ifndef KCT_NO_REFINER_YET
   if (params_.refine && refiner_) {
     const RefineResult refined =
         refiner_->refine(gray, camera_, result.preliminary_object_to_camera,
@@ -153,7 +147,6 @@ TrackResult Tracker::track(const Frame& frame) {
     result.energy_after = refined.energy_after;
     result.hops = refined.hops;
   }
-#endif
 
   // The frame's final pose seeds the extrapolation and the keypoint re-detection, so that
   // keypoint drift is corrected by the refinement (paper Fig. 4).

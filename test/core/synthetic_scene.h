@@ -50,11 +50,13 @@ inline Mesh make_box(double sx, double sy, double sz, bool textured = true, int 
   return mesh;
 }
 
-/// Smooth noisy grey-level background (seeded).
-inline cv::Mat make_background(const cv::Size& size, int seed) {
+/// Smooth random colour background (seeded): uniform noise on a grid of `cell_px` cells with
+/// values in [low, high), upsampled bicubically. Small cells and a wide range make clutter.
+inline cv::Mat make_background(const cv::Size& size, int seed, int cell_px = 16, int low = 40,
+                               int high = 200) {
   cv::RNG rng(seed);
-  cv::Mat small(size.height / 16 + 1, size.width / 16 + 1, CV_8UC3);
-  rng.fill(small, cv::RNG::UNIFORM, 40, 200);
+  cv::Mat small(size.height / cell_px + 1, size.width / cell_px + 1, CV_8UC3);
+  rng.fill(small, cv::RNG::UNIFORM, low, high);
   cv::Mat background;
   cv::resize(small, background, size, 0, 0, cv::INTER_CUBIC);
   return background;

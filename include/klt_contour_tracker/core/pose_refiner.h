@@ -51,7 +51,7 @@ class PoseRefiner {
   std::shared_ptr<const Mesh> mesh_;
   TrackerParams params_;
   std::shared_ptr<const VisibilityTable> visibility_;
-  std::unique_ptr<ContourExtractor> extractor_;
+  std::shared_ptr<const ContourExtractor> extractor_;
   std::unique_ptr<ContourEnergy> energy_;
   std::uint32_t frame_counter_ = 0;
 };

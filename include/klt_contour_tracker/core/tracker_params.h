@@ -46,10 +46,10 @@ struct TrackerParams {
   double extrapolated_rotation_bound_deg = 30.0;   ///< paper: +-Euler angles when extrapolated
   double extrapolated_axial_bound = 0.2;   ///< paper: +- along the camera axis, x object size
   double extrapolated_lateral_bound = 0.1; ///< paper: +- along the other axes, x object size
-  double hop_rotation_deg = 4.0;           ///< ours: standard deviation of a hop's rotation
-  double hop_translation = 0.02;           ///< ours: std. dev. of a hop's translation, x size
-  double metropolis_temperature = 0.02;    ///< ours: Metropolis T, relative to the energy
-  int slsqp_max_evaluations = 60;          ///< ours: energy evaluations per local optimization
+  double hop_rotation_deg = 2.0;           ///< ours: standard deviation of a hop's rotation
+  double hop_translation = 0.01;           ///< ours: std. dev. of a hop's translation, x size
+  double metropolis_temperature = 0.05;    ///< ours: Metropolis T, relative to the energy
+  int slsqp_max_evaluations = 150;         ///< ours: energy evaluations per local optimization
   std::uint32_t random_seed = 1;           ///< ours: seed of the hop generator (reproducible)
 
   /// Throws std::invalid_argument naming the first bad field and its allowed range.

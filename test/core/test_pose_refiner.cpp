@@ -1,0 +1,83 @@
+// Contour-energy refinement (paper Sec. 3.3-3.4) on rendered frames with known poses: a
+// perturbed pose is brought back, and the keypoint search area's bound is kept.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "klt_contour_tracker/core/pose_refiner.h"
+#include "klt_contour_tracker/core/search_area.h"
+#include "synthetic_scene.h"
+
+namespace kct {
+namespace {
+
+class PoseRefinerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    params_.icosphere_subdivisions = 3;  // 642 views: enough for a box, faster to build
+    refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
+    cv::cvtColor(test::render_frame(renderer_, camera_, truth_, background_, 2.0, 1), gray_,
+                 cv::COLOR_BGR2GRAY);
+  }
+
+  std::shared_ptr<const Mesh> mesh_ = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  Renderer renderer_{mesh_};
+  PinholeCamera camera_ = test::make_camera();
+  // An object on a dark, mildly textured table: the silhouette is the strongest edge.
+  cv::Mat background_ = test::make_background(camera_.size(), 21, 32, 10, 60);
+  Pose truth_ = test::make_pose(0.45);
+  TrackerParams params_ = make_preset("paper");
+  std::unique_ptr<PoseRefiner> refiner_;
+  cv::Mat gray_;
+};
+
+TEST_F(PoseRefinerTest, EnergyIsHigherAtTheTruePose) {
+  const Pose off = test::move(truth_, 4.0, {1, 0, 0}, {0.004, 0, 0});
+  EXPECT_GT(refiner_->energy(gray_, camera_, truth_), refiner_->energy(gray_, camera_, off));
+}
+
+TEST_F(PoseRefinerTest, BringsBackAnExtrapolatedPosePerturbedBySevenDegreesAndFivePercent) {
+  // 7 deg about a generic axis and 5% of the 0.156 m size, well inside the +-30 deg /
+  // +-0.1 size box of Sec. 3.4.
+  const double size = mesh_->diameter();
+  const Pose perturbed = test::move(truth_, 7.0, {0.5, -1.0, 0.3},
+                                    Eigen::Vector3d(0.6, -0.5, 0.6).normalized() * 0.05 * size);
+  ASSERT_GT(rotation_error_deg(perturbed, truth_), 6.0);
+  const RefineResult result = refiner_->refine(gray_, camera_, perturbed, nullptr);
+  // Tolerance: 2 mm and 1 deg (the edges of a 0.45 m distant box, 2-level noise).
+  EXPECT_LT(translation_error(result.object_to_camera, truth_), 0.002);
+  EXPECT_LT(rotation_error_deg(result.object_to_camera, truth_), 1.0);
+  EXPECT_GT(result.energy_after, result.energy_before);
+  EXPECT_GT(result.hops, params_.final_hops);
+}
+
+TEST_F(PoseRefinerTest, KeypointSearchAreaKeepsTheReprojectionBound) {
+  // Keypoints whose PnP pose is off by 3 deg: the refined pose may move only as far as the
+  // average reprojection error grows by at most E_max = 2.5 px.
+  const Pose pnp = test::move(truth_, 3.0, {0, 1, 0}, {0.003, 0, 0});
+  KeypointResult keypoints;
+  keypoints.success = true;
+  keypoints.object_to_camera = pnp;
+  for (const Eigen::Vector3d& v : mesh_->vertices) {
+    keypoints.inlier_points.points_object.push_back(v);
+    keypoints.inlier_points.points_image.push_back(camera_.project(pnp * v));
+  }
+  const RefineResult result = refiner_->refine(gray_, camera_, pnp, &keypoints);
+  const ReprojectionConstraint constraint(keypoints.inlier_points.points_object,
+                                          keypoints.inlier_points.points_image, camera_, pnp,
+                                          params_.max_reprojection_increase_px);
+  EXPECT_LE(constraint.average_error_px(result.object_to_camera), 2.5 + 1e-3);
+  // ... and it moves towards the truth, which is outside the bound.
+  EXPECT_LT(rotation_error_deg(result.object_to_camera, truth_), rotation_error_deg(pnp, truth_));
+}
+
+TEST_F(PoseRefinerTest, SameSeedSameResult) {
+  const Pose perturbed = test::move(truth_, 4.0, {0, 0, 1}, {0.0, 0.004, 0.0});
+  PoseRefiner a(mesh_, params_), b(mesh_, params_);
+  const RefineResult ra = a.refine(gray_, camera_, perturbed, nullptr);
+  const RefineResult rb = b.refine(gray_, camera_, perturbed, nullptr);
+  EXPECT_EQ((ra.object_to_camera.matrix() - rb.object_to_camera.matrix()).norm(), 0.0);
+}
+
+}  // namespace
+}  // namespace kct
