@@ -24,7 +24,8 @@
 namespace {
 
 // Accuracy required on every frame of the synthetic sequence (ground truth is exact): 10 mm and
-// 3 deg with the contour refinement (`paper`). Keypoints alone (`klt_only`) drift slowly in
+// 3 deg with the contour refinement (`paper`, the default of nodelet_bag.test; measured: 3.7 mm,
+// 2.8 deg). Keypoints alone (`klt_only`, `rostest ... preset:=klt_only`) drift slowly in
 // rotation (3.8 deg by frame 40 of this sequence), so that baseline gets 5 deg.
 constexpr double kMaxTranslationErrorMm = 10.0;
 double max_rotation_error_deg(const std::string& preset) { return preset == "klt_only" ? 5.0 : 3.0; }
@@ -103,7 +104,7 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
   std::string bag_path, preset;
   // Default: the bag the `tests` target generates (see CMakeLists.txt).
   private_nh.param<std::string>("bag", bag_path, KCT_TEST_DATA_DIR "/small.bag");
-  private_nh.param<std::string>("preset", preset, "klt_only");
+  private_nh.param<std::string>("preset", preset, "paper");
   const std::vector<BagFrame> frames = read_bag(bag_path);
   ASSERT_GE(frames.size(), 10u) << bag_path;
   const double max_r_allowed_deg = max_rotation_error_deg(preset);
