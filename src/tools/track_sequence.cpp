@@ -3,7 +3,7 @@
 //
 //   track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]
 //                  [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]
-//                  [--max-frames N] [--quiet]
+//                  [--max-frames N] [--errors FILE] [--quiet]
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -24,7 +24,8 @@ void usage(const char* error) {
   if (error) std::cerr << "track_sequence: " << error << "\n";
   std::cerr << "usage: track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]\n"
                "                      [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]\n"
-               "                      [--max-frames N] [--quiet]\n"
+               "                      [--max-frames N] [--errors FILE] [--quiet]\n"
+               "  --errors FILE writes the per-frame error delta_i (Sec. 4.1, model units), one a line.\n"
                "  DIR holds images (sorted by name), K.txt and pose.txt (first line = initial pose;\n"
                "  the rest, when present, is the ground truth used for scoring).\n"
                "  presets: ";
@@ -34,7 +35,7 @@ void usage(const char* error) {
 }
 
 struct Options {
-  std::string sequence, model, preset = "paper", output, summary_json;
+  std::string sequence, model, preset = "paper", output, summary_json, errors;
   double model_scale = 1.0;
   int max_frames = -1;
   bool quiet = false;
@@ -56,6 +57,7 @@ Options parse(int argc, char** argv) {
       else if (arg == "--preset") o.preset = value();
       else if (arg == "--output") o.output = value();
       else if (arg == "--summary-json") o.summary_json = value();
+      else if (arg == "--errors") o.errors = value();
       else if (arg == "--max-frames") o.max_frames = std::stoi(value());
       else if (arg == "--quiet") o.quiet = true;
       else if (arg == "--param") {
@@ -132,6 +134,12 @@ int main(int argc, char** argv) {
       const std::vector<kct::Pose> mine(estimated.begin(), estimated.begin() + scored);
       for (size_t i = 0; i < scored; ++i)
         deltas.push_back(kct::mean_vertex_distance(mesh->vertices, mine[i], truth[i]));
+      if (!options.errors.empty()) {
+        std::ofstream out(options.errors);
+        out << std::setprecision(9);
+        for (double d : deltas) out << d << "\n";
+        if (!out) throw std::runtime_error(options.errors + ": cannot write");
+      }
       double mean_add = 0;
       for (double d : deltas) mean_add += d;
       mean_add /= deltas.size();
