@@ -83,6 +83,20 @@ cv::Mat Tracker::to_gray(const cv::Mat& image) const {
   return gray;
 }
 
+bool Tracker::keypoints_agree_with(const TrackResult& result) const {
+  if (!result.refined || !result.keypoints.success) return true;
+  const KeypointInliers& inliers = result.keypoints.inlier_points;
+  if (inliers.points_object.empty()) return true;
+  auto mean_error_px = [&](const Pose& pose) {
+    double sum = 0.0;
+    for (size_t i = 0; i < inliers.points_object.size(); ++i)
+      sum += (camera_.project(pose * inliers.points_object[i]) - inliers.points_image[i]).norm();
+    return sum / inliers.points_object.size();
+  };
+  return mean_error_px(result.object_to_camera) - mean_error_px(result.keypoints.object_to_camera) <=
+         params_.redetect_max_reprojection_increase_px;
+}
+
 TrackResult Tracker::track(const Frame& frame) {
   const auto start = std::chrono::steady_clock::now();
   TrackResult result;
@@ -156,7 +170,8 @@ TrackResult Tracker::track(const Frame& frame) {
   ++frames_since_detection_;
   const bool interval_due = params_.redetect_interval_frames > 0 &&
                             frames_since_detection_ >= params_.redetect_interval_frames;
-  if (!result.keypoints.success || keypoints_.needs_redetection() || interval_due) {
+  if (!result.keypoints.success ||
+      ((keypoints_.needs_redetection() || interval_due) && keypoints_agree_with(result))) {
     keypoints_.detect(gray, pose_i1_, camera_);
     frames_since_detection_ = 0;
   }

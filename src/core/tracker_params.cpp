@@ -30,6 +30,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(klt_window_px), KCT_FIELD(klt_pyramid_levels), KCT_FIELD(klt_forward_backward_px),
       KCT_FIELD(ransac_reprojection_px), KCT_FIELD(ransac_iterations), KCT_FIELD(klt_min_points),
       KCT_FIELD(klt_min_inlier_ratio), KCT_FIELD(redetect_ratio), KCT_FIELD(redetect_interval_frames),
+      KCT_FIELD(redetect_max_reprojection_increase_px),
       KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
       KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
       KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
@@ -103,6 +104,8 @@ void TrackerParams::validate() const {
   check_range("klt_min_inlier_ratio", klt_min_inlier_ratio, 0.0, 1.0);
   check_range("redetect_ratio", redetect_ratio, 0.0, 1.0);
   check_range("redetect_interval_frames", redetect_interval_frames, 0, 1000000);
+  check_range("redetect_max_reprojection_increase_px", redetect_max_reprojection_increase_px, 0.0,
+              1e6);
   check_range("sharp_edge_angle_deg", sharp_edge_angle_deg, 0.0, 180.0);
   check_range("icosphere_subdivisions", icosphere_subdivisions, 0, 6);
   check_range("visibility_resolution_px", visibility_resolution_px, 16, 4096);
@@ -132,6 +135,7 @@ TrackerParams make_preset(const std::string& name) {
   if (name == "paper") return params;
   if (name == "klt_only") {
     params.refine = false;
+    params.redetect_interval_frames = 0;
     return params;
   }
   std::string known;

@@ -28,6 +28,8 @@ TEST(TrackerParams, PaperPresetHoldsThePapersValues) {
 
 TEST(TrackerParams, KltOnlySkipsTheRefinement) {
   EXPECT_FALSE(make_preset("klt_only").refine);
+  EXPECT_EQ(make_preset("klt_only").redetect_interval_frames, 0);
+  EXPECT_EQ(make_preset("paper").redetect_interval_frames, 1);
 }
 
 TEST(TrackerParams, UnknownPresetNamesTheKnownOnes) {
@@ -71,7 +73,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 33u);
+  EXPECT_EQ(fields.size(), 34u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

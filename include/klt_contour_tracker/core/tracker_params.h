@@ -26,8 +26,15 @@ struct TrackerParams {
   /// ours: re-detect keypoints from the newest pose when the tracked inliers fall below this
   /// fraction of the count at the last detection.
   double redetect_ratio = 0.6;
-  /// ours: also re-detect every N frames (0 = only when the points thin out).
-  int redetect_interval_frames = 0;
+  /// Also re-detect every N frames (0 = only when the points thin out). 1 follows the paper
+  /// ("on the frames where the object pose is known, we identify 2D keypoints", Sec. 3.1): each
+  /// refined pose re-anchors fresh keypoints, so KLT drift never accumulates.
+  int redetect_interval_frames = 1;
+  /// ours: keypoints are re-anchored on the refined pose only when the KLT inliers' mean
+  /// reprojection error there exceeds the PnP pose's by at most this much, px. A refinement
+  /// that lands in a wrong optimum (the energy is nearly flat between some poses) then stays a
+  /// one-frame error instead of being baked into the new anchors.
+  double redetect_max_reprojection_increase_px = 0.5;
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline
@@ -67,7 +74,9 @@ std::vector<std::pair<std::string, std::string>> describe(const TrackerParams& p
 /// Names accepted by make_preset().
 std::vector<std::string> preset_names();
 
-/// "paper": the paper's values (the defaults). "klt_only": paper without refinement.
+/// "paper": the paper's values (the defaults). "klt_only": keypoints only, no refinement; it
+/// re-detects only when the tracks thin out, since re-anchoring every frame on unrefined poses
+/// accumulates drift (the strongest keypoint-only baseline, measured in docs/benchmarks.md).
 /// Throws std::invalid_argument for an unknown name, listing the known ones.
 TrackerParams make_preset(const std::string& name);
 
