@@ -35,13 +35,8 @@ void Tracker::set_camera(const PinholeCamera& camera) {
   if (camera.width() <= 0 || camera.height() <= 0)
     throw std::invalid_argument("Tracker: camera has no image size");
   camera_ = camera;
-  undistort_map_x_.release();
-  undistort_map_y_.release();
-  if (camera.has_distortion()) {
-    // Frames are undistorted once with the same K, then everything uses the ideal pinhole.
-    cv::initUndistortRectifyMap(camera.K(), camera.distortion(), cv::noArray(), camera.K(),
-                                camera.size(), CV_32FC1, undistort_map_x_, undistort_map_y_);
-  }
+  // Frames are undistorted once with the same K, then everything uses the ideal pinhole.
+  camera.undistortion_maps(undistort_map_x_, undistort_map_y_);
 }
 
 void Tracker::set_params(const TrackerParams& params) {
