@@ -1,6 +1,8 @@
 #include "klt_contour_tracker/core/tracker.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -16,6 +18,7 @@ const char* to_string(TrackStatus status) {
     case TrackStatus::kKeypoints: return "keypoints";
     case TrackStatus::kExtrapolated: return "extrapolated";
     case TrackStatus::kInvalidInput: return "invalid_input";
+    case TrackStatus::kReacquired: return "reacquired";
   }
   return "unknown";
 }
@@ -92,6 +95,69 @@ bool Tracker::keypoints_agree_with(const TrackResult& result) const {
          params_.redetect_max_reprojection_increase_px;
 }
 
+const ContourExtractor* Tracker::contour_extractor() const {
+  return refiner_ ? &refiner_->contour_extractor() : nullptr;
+}
+
+std::string Tracker::check_frame(const Frame& frame) const {
+  if (frame.image.empty()) return "empty image";
+  if (frame.image.depth() != CV_8U || (frame.image.channels() != 1 && frame.image.channels() != 3))
+    return "image must be 8-bit grey or BGR";
+  if (frame.image.size() != camera_.size())
+    return "image is " + std::to_string(frame.image.cols) + "x" + std::to_string(frame.image.rows) +
+           " but the camera is " + std::to_string(camera_.width()) + "x" +
+           std::to_string(camera_.height());
+  return "";
+}
+
+TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double search_scale) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!(search_scale >= 1.0) || !std::isfinite(search_scale))
+    throw std::invalid_argument("Tracker::reacquire: search_scale must be >= 1");
+  if (!is_valid_pose(around) || around.translation().z() <= 0)
+    throw std::invalid_argument("Tracker::reacquire: pose is invalid or behind the camera");
+  TrackResult result;
+  result.message = check_frame(frame);
+  if (!result.message.empty()) {
+    result.status = TrackStatus::kInvalidInput;
+  } else {
+    const cv::Mat gray = to_gray(frame.image);
+    result.status = TrackStatus::kReacquired;
+    result.object_to_camera = result.preliminary_object_to_camera = around;
+    if (params_.refine && refiner_) {
+      TrackerParams widened = params_;
+      widened.extrapolated_rotation_bound_deg =
+          std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);
+      widened.extrapolated_axial_bound *= search_scale;
+      widened.extrapolated_lateral_bound *= search_scale;
+      refiner_->set_params(widened);  // only the box changes: nothing is rebuilt
+      RefineResult refined;
+      try {
+        refined = refiner_->refine(gray, camera_, around, nullptr);
+      } catch (...) {
+        refiner_->set_params(params_);
+        throw;
+      }
+      refiner_->set_params(params_);
+      if (is_valid_pose(refined.object_to_camera) && refined.object_to_camera.translation().z() > 0) {
+        result.object_to_camera = refined.object_to_camera;
+        result.refined = true;
+      }
+      result.energy_before = refined.energy_before;
+      result.energy_after = refined.energy_after;
+      result.hops = refined.hops;
+    }
+    pose_i1_ = pose_i2_ = result.object_to_camera;
+    keypoints_.clear();
+    keypoints_.detect(gray, pose_i1_, camera_);
+    frames_since_detection_ = 0;
+    state_ = State::kTracking;
+  }
+  result.frame_time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
 TrackResult Tracker::track(const Frame& frame) {
   const auto start = std::chrono::steady_clock::now();
   TrackResult result;
@@ -100,21 +166,9 @@ TrackResult Tracker::track(const Frame& frame) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
-  if (frame.image.empty()) {
+  result.message = check_frame(frame);
+  if (!result.message.empty()) {
     result.status = TrackStatus::kInvalidInput;
-    result.message = "empty image";
-    return finish();
-  }
-  if (frame.image.depth() != CV_8U || (frame.image.channels() != 1 && frame.image.channels() != 3)) {
-    result.status = TrackStatus::kInvalidInput;
-    result.message = "image must be 8-bit grey or BGR";
-    return finish();
-  }
-  if (frame.image.size() != camera_.size()) {
-    result.status = TrackStatus::kInvalidInput;
-    result.message = "image is " + std::to_string(frame.image.cols) + "x" +
-                     std::to_string(frame.image.rows) + " but the camera is " +
-                     std::to_string(camera_.width()) + "x" + std::to_string(camera_.height());
     return finish();
   }
   if (state_ == State::kWaiting) {

@@ -17,6 +17,7 @@
 namespace kct {
 
 class PoseRefiner;
+class ContourExtractor;
 
 /// One camera image. 8-bit grey (CV_8UC1) or BGR (CV_8UC3); undistorted unless the camera
 /// given to the tracker has distortion coefficients.
@@ -32,6 +33,7 @@ enum class TrackStatus {
   kKeypoints,       ///< preliminary pose from KLT + PnP
   kExtrapolated,    ///< KLT failed: preliminary pose extrapolated from the two previous poses
   kInvalidInput,    ///< empty image, wrong type or size: frame skipped, state unchanged
+  kReacquired,      ///< reacquire(): preliminary pose = the given pose, widened search area
 };
 const char* to_string(TrackStatus status);
 
@@ -67,6 +69,14 @@ class Tracker {
   /// Runs the pipeline on one frame.
   TrackResult track(const Frame& frame);
 
+  /// Re-acquisition of a lost track (ours, not in the paper): refines `around` (e.g. the last
+  /// good pose, object_to_camera) on `frame` inside the extrapolated search box (Sec. 3.4)
+  /// scaled by `search_scale` (>= 1; rotation bound capped at 180 deg), without keypoints, then
+  /// re-anchors the keypoints on the result and continues tracking from it. Without refinement
+  /// (klt_only) the pose is `around`. Status kReacquired, or kInvalidInput as in track().
+  /// Throws std::invalid_argument for an invalid `around` or search_scale < 1.
+  TrackResult reacquire(const Frame& frame, const Pose& around, double search_scale);
+
   /// Changes the intrinsics (e.g. a new camera_info); keeps the track.
   void set_camera(const PinholeCamera& camera);
   const PinholeCamera& camera() const { return camera_; }
@@ -74,12 +84,17 @@ class Tracker {
   void set_params(const TrackerParams& params);
   const TrackerParams& params() const { return params_; }
   const Mesh& mesh() const { return *mesh_; }
+  /// The refiner's contour extractor (with its visibility table), e.g. for drawing the model's
+  /// contour; null when the refinement is off.
+  const ContourExtractor* contour_extractor() const;
   /// Last pose output (valid when is_initialized()).
   const Pose& last_pose() const { return pose_i1_; }
 
  private:
   enum class State { kWaiting, kPendingFirstFrame, kTracking };
   cv::Mat to_gray(const cv::Mat& image) const;
+  /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
+  std::string check_frame(const Frame& frame) const;
   /// True unless the refined pose moved the KLT inliers' mean reprojection error up by more
   /// than redetect_max_reprojection_increase_px over the PnP pose (then keypoints are not
   /// re-anchored on it).

@@ -1,0 +1,100 @@
+#pragma once
+/// \file track_quality.h
+/// Per-frame tracking quality and the WAITING_FOR_POSE / TRACKING / LOST state machine (ours;
+/// the paper has no failure detection). A frame's quality mixes two cues the pipeline already
+/// computes: the contour energy at the final pose (Eq. 5) relative to its running level over
+/// recent good frames, and the KLT RANSAC inlier ratio. The monitor only classifies results;
+/// the caller decides what to do (e.g. Tracker::reacquire() while lost).
+
+#include <string>
+
+#include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/tracker.h"
+
+namespace kct {
+
+/// Tracking state of one object.
+enum class TrackState {
+  kWaitingForPose,  ///< no pose given yet (or reset): nothing is tracked
+  kTracking,        ///< the track is good (or has been bad for fewer than lost_after_bad_frames)
+  kLost,            ///< lost_after_bad_frames bad frames in a row; re-acquiring
+};
+/// "waiting_for_pose", "tracking", "lost".
+const char* to_string(TrackState state);
+
+/// Thresholds of the quality score and the state machine (all ours).
+struct TrackQualityParams {
+  /// Weight of the energy cue in the score when the refinement ran; the KLT inlier ratio gets
+  /// 1 - energy_weight. Without refinement (klt_only) the score is the inlier ratio alone.
+  double energy_weight = 0.7;
+  /// A frame is good when its score is at least this, [0, 1].
+  double min_quality = 0.5;
+  /// Exponential-moving-average factor of the energy level over good frames, (0, 1].
+  double energy_level_smoothing = 0.1;
+  /// TRACKING -> LOST after this many consecutive bad frames.
+  int lost_after_bad_frames = 5;
+  /// LOST -> TRACKING after this many consecutive good frames.
+  int recover_after_good_frames = 3;
+  /// While lost, the extrapolated search box (Sec. 3.4) is scaled by this for re-acquisition.
+  double reacquire_search_scale = 2.0;
+
+  /// Throws std::invalid_argument naming the first bad field and its allowed range.
+  void validate() const;
+};
+
+/// Scores TrackResults and runs the state machine. Transitions:
+/// WAITING_FOR_POSE -> TRACKING on on_initialized(); TRACKING -> LOST after
+/// lost_after_bad_frames bad frames in a row; LOST -> TRACKING after recover_after_good_frames
+/// good frames in a row; any state -> WAITING_FOR_POSE on reset() or a kNotInitialized result.
+/// kInvalidInput results change nothing.
+class TrackQualityMonitor {
+ public:
+  /// Throws std::invalid_argument if the parameters do not validate.
+  explicit TrackQualityMonitor(const TrackQualityParams& params = {});
+
+  /// Quality of one result in [0, 1] given the current energy level (does not change state):
+  /// e = clamp(energy_after / level, 0, 1) (1 while no level is known yet), k = KLT inlier ratio
+  /// (0 when KLT failed); score = energy_weight * e + (1 - energy_weight) * k if refined, else k.
+  /// kInitialized and kReacquired-without-refinement results score 1 (the pose was given).
+  double score(const TrackResult& result) const;
+
+  /// Scores `result`, updates the energy level (good frames only), the last good pose and the
+  /// state. Returns the new state.
+  TrackState update(const TrackResult& result);
+
+  /// A pose was given to the tracker: TRACKING, counters cleared, the energy level forgotten.
+  void on_initialized(const Pose& object_to_camera);
+  /// The track was dropped: WAITING_FOR_POSE.
+  void reset();
+
+  TrackState state() const { return state_; }
+  /// True while LOST and the last frame was bad: the caller should re-acquire around
+  /// last_good_pose() instead of tracking from the last (bad) pose.
+  bool should_reacquire() const { return state_ == TrackState::kLost && good_frames_ == 0; }
+  /// Score of the last update() (0 before any).
+  double last_quality() const { return last_quality_; }
+  /// Whether the last update() was a good frame.
+  bool last_good() const { return last_good_; }
+  /// Pose of the last good frame (or the last given pose), object_to_camera.
+  const Pose& last_good_pose() const { return last_good_pose_; }
+  /// Running contour-energy level of good refined frames (0 when none yet).
+  double energy_level() const { return energy_level_; }
+  int consecutive_bad_frames() const { return bad_frames_; }
+  int consecutive_good_frames() const { return good_frames_; }
+  const TrackQualityParams& params() const { return params_; }
+  /// Validates and replaces the thresholds; keeps the state.
+  void set_params(const TrackQualityParams& params);
+
+ private:
+  TrackQualityParams params_;
+  TrackState state_ = TrackState::kWaitingForPose;
+  Pose last_good_pose_ = Pose::Identity();
+  double energy_level_ = 0.0;
+  bool has_energy_level_ = false;
+  double last_quality_ = 0.0;
+  bool last_good_ = false;
+  int bad_frames_ = 0;
+  int good_frames_ = 0;
+};
+
+}  // namespace kct

@@ -1,0 +1,109 @@
+#include "klt_contour_tracker/core/track_quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kct {
+namespace {
+
+void check_range(const char* name, double value, double low, double high) {
+  if (!std::isfinite(value) || value < low || value > high)
+    throw std::invalid_argument(std::string("TrackQualityParams.") + name + " must be in [" +
+                                std::to_string(low) + ", " + std::to_string(high) + "], got " +
+                                std::to_string(value));
+}
+
+}  // namespace
+
+const char* to_string(TrackState state) {
+  switch (state) {
+    case TrackState::kWaitingForPose: return "waiting_for_pose";
+    case TrackState::kTracking: return "tracking";
+    case TrackState::kLost: return "lost";
+  }
+  return "unknown";
+}
+
+void TrackQualityParams::validate() const {
+  check_range("energy_weight", energy_weight, 0.0, 1.0);
+  check_range("min_quality", min_quality, 0.0, 1.0);
+  check_range("energy_level_smoothing", energy_level_smoothing, 1e-6, 1.0);
+  check_range("lost_after_bad_frames", lost_after_bad_frames, 1, 1000);
+  check_range("recover_after_good_frames", recover_after_good_frames, 1, 1000);
+  check_range("reacquire_search_scale", reacquire_search_scale, 1.0, 10.0);
+}
+
+TrackQualityMonitor::TrackQualityMonitor(const TrackQualityParams& params) : params_(params) {
+  params_.validate();
+}
+
+void TrackQualityMonitor::set_params(const TrackQualityParams& params) {
+  params.validate();
+  params_ = params;
+}
+
+double TrackQualityMonitor::score(const TrackResult& result) const {
+  if (result.status == TrackStatus::kInitialized) return 1.0;
+  if (result.status == TrackStatus::kNotInitialized || result.status == TrackStatus::kInvalidInput)
+    return 0.0;
+  if (result.status == TrackStatus::kReacquired && !result.refined) return 1.0;
+  const double k = result.keypoints.success ? std::clamp(result.keypoints.inlier_ratio, 0.0, 1.0) : 0.0;
+  if (!result.refined) return k;
+  double e = 1.0;
+  if (has_energy_level_ && energy_level_ > 0.0)
+    e = std::clamp(result.energy_after / energy_level_, 0.0, 1.0);
+  if (!std::isfinite(e)) e = 0.0;
+  return params_.energy_weight * e + (1.0 - params_.energy_weight) * k;
+}
+
+TrackState TrackQualityMonitor::update(const TrackResult& result) {
+  if (result.status == TrackStatus::kInvalidInput) return state_;
+  if (result.status == TrackStatus::kNotInitialized) {
+    reset();
+    return state_;
+  }
+  if (state_ == TrackState::kWaitingForPose) {
+    // A result with a pose while waiting: the tracker was initialized behind our back.
+    on_initialized(result.object_to_camera);
+  }
+  last_quality_ = score(result);
+  last_good_ = last_quality_ >= params_.min_quality;
+  if (last_good_) {
+    last_good_pose_ = result.object_to_camera;
+    if (result.refined && std::isfinite(result.energy_after)) {
+      const double a = params_.energy_level_smoothing;
+      energy_level_ = has_energy_level_ ? (1.0 - a) * energy_level_ + a * result.energy_after
+                                        : result.energy_after;
+      has_energy_level_ = true;
+    }
+    bad_frames_ = 0;
+    ++good_frames_;
+    if (state_ == TrackState::kLost && good_frames_ >= params_.recover_after_good_frames)
+      state_ = TrackState::kTracking;
+  } else {
+    good_frames_ = 0;
+    ++bad_frames_;
+    if (state_ == TrackState::kTracking && bad_frames_ >= params_.lost_after_bad_frames)
+      state_ = TrackState::kLost;
+  }
+  return state_;
+}
+
+void TrackQualityMonitor::on_initialized(const Pose& object_to_camera) {
+  state_ = TrackState::kTracking;
+  last_good_pose_ = object_to_camera;
+  energy_level_ = 0.0;
+  has_energy_level_ = false;
+  bad_frames_ = good_frames_ = 0;
+}
+
+void TrackQualityMonitor::reset() {
+  state_ = TrackState::kWaitingForPose;
+  bad_frames_ = good_frames_ = 0;
+  energy_level_ = 0.0;
+  has_energy_level_ = false;
+  last_good_ = false;
+}
+
+}  // namespace kct

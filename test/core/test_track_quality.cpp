@@ -1,0 +1,151 @@
+// The quality score and the WAITING_FOR_POSE / TRACKING / LOST state machine, on hand-made
+// TrackResults (the score only reads the result's statistics).
+#include <gtest/gtest.h>
+
+#include "klt_contour_tracker/core/track_quality.h"
+
+namespace kct {
+namespace {
+
+TrackResult refined_result(double energy_after, bool klt_success, double inlier_ratio) {
+  TrackResult r;
+  r.status = klt_success ? TrackStatus::kKeypoints : TrackStatus::kExtrapolated;
+  r.refined = true;
+  r.energy_after = energy_after;
+  r.keypoints.success = klt_success;
+  r.keypoints.inlier_ratio = inlier_ratio;
+  r.object_to_camera = Pose::Identity();
+  r.object_to_camera.translation() = Eigen::Vector3d(0, 0, 0.5);
+  return r;
+}
+
+TEST(TrackQuality, ScoreMixesEnergyRatioAndInlierRatio) {
+  TrackQualityParams params;
+  params.energy_weight = 0.7;
+  params.energy_level_smoothing = 1.0;  // level = the last good energy
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  // No level yet: the energy cue counts as 1.
+  EXPECT_NEAR(monitor.score(refined_result(10.0, true, 0.5)), 0.7 + 0.3 * 0.5, 1e-12);
+  monitor.update(refined_result(20.0, true, 1.0));
+  EXPECT_DOUBLE_EQ(monitor.energy_level(), 20.0);
+  // Half the level, KLT failed: 0.7 * 0.5.
+  EXPECT_NEAR(monitor.score(refined_result(10.0, false, 0.9)), 0.35, 1e-12);
+  // Above the level the energy cue saturates at 1.
+  EXPECT_NEAR(monitor.score(refined_result(40.0, true, 0.8)), 0.7 + 0.3 * 0.8, 1e-12);
+  // Without refinement (klt_only) the score is the inlier ratio.
+  TrackResult klt = refined_result(0.0, true, 0.42);
+  klt.refined = false;
+  EXPECT_NEAR(monitor.score(klt), 0.42, 1e-12);
+  klt.keypoints.success = false;
+  EXPECT_EQ(monitor.score(klt), 0.0);
+  TrackResult initialized;
+  initialized.status = TrackStatus::kInitialized;
+  EXPECT_EQ(monitor.score(initialized), 1.0);
+}
+
+TEST(TrackQuality, EnergyLevelIsAMovingAverageOfGoodFramesOnly) {
+  TrackQualityParams params;
+  params.energy_level_smoothing = 0.5;
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  monitor.update(refined_result(10.0, true, 1.0));
+  monitor.update(refined_result(20.0, true, 1.0));
+  EXPECT_DOUBLE_EQ(monitor.energy_level(), 15.0);
+  monitor.update(refined_result(1.0, false, 0.0));  // bad: 0.7 * 1/15 < 0.5
+  EXPECT_FALSE(monitor.last_good());
+  EXPECT_DOUBLE_EQ(monitor.energy_level(), 15.0);
+}
+
+TEST(TrackQuality, LostAfterTheStatedBadFramesAndRecoversAfterTheStatedGoodFrames) {
+  TrackQualityParams params;
+  params.lost_after_bad_frames = 3;
+  params.recover_after_good_frames = 2;
+  TrackQualityMonitor monitor(params);
+  EXPECT_EQ(monitor.state(), TrackState::kWaitingForPose);
+  Pose given = Pose::Identity();
+  given.translation() = Eigen::Vector3d(0.1, 0, 0.4);
+  monitor.on_initialized(given);
+  EXPECT_EQ(monitor.state(), TrackState::kTracking);
+
+  TrackResult good = refined_result(10.0, true, 0.9);
+  good.object_to_camera.translation() = Eigen::Vector3d(0.2, 0, 0.4);
+  const TrackResult bad = refined_result(1.0, false, 0.0);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(monitor.update(good), TrackState::kTracking);
+  // Two bad frames and a good one: the bad count restarts.
+  EXPECT_EQ(monitor.update(bad), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(bad), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(good), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(bad), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(bad), TrackState::kTracking);
+  EXPECT_FALSE(monitor.should_reacquire());
+  EXPECT_EQ(monitor.update(bad), TrackState::kLost);
+  EXPECT_TRUE(monitor.should_reacquire());
+  EXPECT_EQ(monitor.consecutive_bad_frames(), 3);
+  // The last good pose is the last good frame's, not the bad frames'.
+  EXPECT_LT(translation_error(monitor.last_good_pose(), good.object_to_camera), 1e-12);
+
+  // One good frame while lost is not enough; a bad one in between restarts the count.
+  EXPECT_EQ(monitor.update(good), TrackState::kLost);
+  EXPECT_FALSE(monitor.should_reacquire());
+  EXPECT_EQ(monitor.update(bad), TrackState::kLost);
+  EXPECT_TRUE(monitor.should_reacquire());
+  EXPECT_EQ(monitor.update(good), TrackState::kLost);
+  EXPECT_EQ(monitor.update(good), TrackState::kTracking);
+  EXPECT_EQ(monitor.consecutive_bad_frames(), 0);
+}
+
+TEST(TrackQuality, InvalidInputChangesNothingAndNotInitializedMeansWaiting) {
+  TrackQualityParams params;
+  params.lost_after_bad_frames = 1;
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  TrackResult invalid;
+  invalid.status = TrackStatus::kInvalidInput;
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(monitor.update(invalid), TrackState::kTracking);
+  TrackResult waiting;
+  waiting.status = TrackStatus::kNotInitialized;
+  EXPECT_EQ(monitor.update(waiting), TrackState::kWaitingForPose);
+  monitor.on_initialized(Pose::Identity());
+  monitor.reset();
+  EXPECT_EQ(monitor.state(), TrackState::kWaitingForPose);
+  EXPECT_STREQ(to_string(TrackState::kLost), "lost");
+  EXPECT_STREQ(to_string(TrackState::kWaitingForPose), "waiting_for_pose");
+}
+
+TEST(TrackQuality, InitializationForgetsTheEnergyLevel) {
+  TrackQualityMonitor monitor;
+  monitor.on_initialized(Pose::Identity());
+  monitor.update(refined_result(50.0, true, 1.0));
+  EXPECT_GT(monitor.energy_level(), 0.0);
+  monitor.on_initialized(Pose::Identity());
+  EXPECT_EQ(monitor.energy_level(), 0.0);
+  EXPECT_NEAR(monitor.score(refined_result(5.0, false, 0.0)), 0.7, 1e-12);
+}
+
+TEST(TrackQuality, ParametersAreValidated) {
+  TrackQualityParams params;
+  EXPECT_NO_THROW(params.validate());
+  auto expect_invalid = [](auto spoil, const char* field) {
+    TrackQualityParams p;
+    spoil(p);
+    try {
+      p.validate();
+      ADD_FAILURE() << field << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  expect_invalid([](TrackQualityParams& p) { p.energy_weight = 1.5; }, "energy_weight");
+  expect_invalid([](TrackQualityParams& p) { p.min_quality = -0.1; }, "min_quality");
+  expect_invalid([](TrackQualityParams& p) { p.energy_level_smoothing = 0.0; }, "energy_level_smoothing");
+  expect_invalid([](TrackQualityParams& p) { p.lost_after_bad_frames = 0; }, "lost_after_bad_frames");
+  expect_invalid([](TrackQualityParams& p) { p.recover_after_good_frames = 0; }, "recover_after_good_frames");
+  expect_invalid([](TrackQualityParams& p) { p.reacquire_search_scale = 0.5; }, "reacquire_search_scale");
+  expect_invalid([](TrackQualityParams& p) { p.min_quality = std::nan(""); }, "min_quality");
+  params.lost_after_bad_frames = 0;
+  EXPECT_THROW(TrackQualityMonitor{params}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace kct
