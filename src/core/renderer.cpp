@@ -39,6 +39,14 @@ inline double edge(const ScreenVertex& a, const ScreenVertex& b, double px, doub
   return (b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x);
 }
 
+/// edge() with the end points taken in a fixed order, so that (a, b) and (b, a) give exactly
+/// opposite values: two triangles sharing an edge then agree bit for bit on which side of it a
+/// pixel centre lies, and no pixel along the edge is left to neither (no cracks).
+inline double shared_edge(const ScreenVertex& a, const ScreenVertex& b, double px, double py) {
+  if (a.x < b.x || (a.x == b.x && a.y < b.y)) return edge(a, b, px, py);
+  return -edge(b, a, px, py);
+}
+
 /// Top-left fill rule for the orientation with positive area: pixels exactly on a top or left
 /// edge belong to the triangle, on a bottom or right edge to its neighbour, so shared edges
 /// are drawn once and the covered area equals the geometric area.
@@ -65,16 +73,17 @@ void rasterize(ScreenVertex v0, ScreenVertex v1, ScreenVertex v2, int face, Buff
   if (x_min > x_max || y_min > y_max) return;
 
   const bool tl0 = is_top_left(v1, v2), tl1 = is_top_left(v2, v0), tl2 = is_top_left(v0, v1);
-  // Edge functions are affine: e(x + 1, y) = e(x, y) + step_x.
-  const double step0 = -(v2.y - v1.y), step1 = -(v0.y - v2.y), step2 = -(v1.y - v0.y);
   const double inv_area = 1.0 / area;
   const bool write_uv = !buffers.uv.empty();
 
   for (int y = y_min; y <= y_max; ++y) {
-    double e0 = edge(v1, v2, x_min, y), e1 = edge(v2, v0, x_min, y), e2 = edge(v0, v1, x_min, y);
     float* key_row = buffers.key.ptr<float>(y);
     int* face_row = buffers.face_index.ptr<int>(y);
-    for (int x = x_min; x <= x_max; ++x, e0 += step0, e1 += step1, e2 += step2) {
+    for (int x = x_min; x <= x_max; ++x) {
+      // Evaluated per pixel, not stepped incrementally: stepping accumulates rounding that
+      // differs between the two triangles of a shared edge.
+      const double e0 = shared_edge(v1, v2, x, y), e1 = shared_edge(v2, v0, x, y),
+                   e2 = shared_edge(v0, v1, x, y);
       if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) continue;
       if ((e0 == 0.0 && !tl0) || (e1 == 0.0 && !tl1) || (e2 == 0.0 && !tl2)) continue;
       const double w0 = e0 * inv_area, w1 = e1 * inv_area, w2 = e2 * inv_area;
