@@ -3,9 +3,10 @@
 //
 //   track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]
 //                  [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]
-//                  [--max-frames N] [--errors FILE] [--quiet]
+//                  [--max-frames N] [--errors FILE] [--debug-dir DIR [--debug-every N]] [--quiet]
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "klt_contour_tracker/core/debug_drawing.h"
 #include "klt_contour_tracker/core/metrics.h"
 #include "klt_contour_tracker/core/sequence_io.h"
 #include "klt_contour_tracker/core/tracker.h"
@@ -24,8 +26,11 @@ void usage(const char* error) {
   if (error) std::cerr << "track_sequence: " << error << "\n";
   std::cerr << "usage: track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]\n"
                "                      [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]\n"
-               "                      [--max-frames N] [--errors FILE] [--quiet]\n"
+               "                      [--max-frames N] [--errors FILE] [--debug-dir DIR [--debug-every N]]\n"
+               "                      [--quiet]\n"
                "  --errors FILE writes the per-frame error delta_i (Sec. 4.1, model units), one a line.\n"
+               "  --debug-dir DIR writes the tracking overlay (contour, keypoints, axes, status) of every\n"
+               "  N-th frame (default 1) as DIR/<frame>.png.\n"
                "  DIR holds images (sorted by name), K.txt and pose.txt (first line = initial pose;\n"
                "  the rest, when present, is the ground truth used for scoring).\n"
                "  presets: ";
@@ -35,7 +40,8 @@ void usage(const char* error) {
 }
 
 struct Options {
-  std::string sequence, model, preset = "paper", output, summary_json, errors;
+  std::string sequence, model, preset = "paper", output, summary_json, errors, debug_dir;
+  int debug_every = 1;
   double model_scale = 1.0;
   int max_frames = -1;
   bool quiet = false;
@@ -60,6 +66,8 @@ Options parse(int argc, char** argv) {
       else if (arg == "--errors") o.errors = value();
       else if (arg == "--max-frames") o.max_frames = std::stoi(value());
       else if (arg == "--quiet") o.quiet = true;
+      else if (arg == "--debug-dir") o.debug_dir = value();
+      else if (arg == "--debug-every") o.debug_every = std::max(1, std::stoi(value()));
       else if (arg == "--param") {
         const std::string kv = value();
         const auto eq = kv.find('=');
@@ -97,6 +105,7 @@ int main(int argc, char** argv) {
     kct::Tracker tracker(mesh, camera, params);
     tracker.initialize(sequence.poses.front());
 
+    if (!options.debug_dir.empty()) std::filesystem::create_directories(options.debug_dir);
     std::vector<kct::Pose> estimated;
     std::vector<double> frame_ms;
     int extrapolated = 0;
@@ -109,6 +118,12 @@ int main(int argc, char** argv) {
       estimated.push_back(result.object_to_camera);
       if (i > 0) frame_ms.push_back(result.frame_time_ms);
       if (result.status == kct::TrackStatus::kExtrapolated) ++extrapolated;
+      if (!options.debug_dir.empty() && i % options.debug_every == 0) {
+        const std::string path = options.debug_dir + "/" + kct::frame_file_name(static_cast<int>(i));
+        if (!cv::imwrite(path, kct::draw_tracking_overlay(image, result, tracker.camera(), *mesh,
+                                                         tracker.contour_extractor())))
+          throw std::runtime_error(path + ": cannot write");
+      }
       if (!options.quiet) {
         std::cerr << "\r[" << (i + 1) << "/" << frames << "] " << std::setw(12) << kct::to_string(result.status)
                   << "  " << std::fixed << std::setprecision(1) << result.frame_time_ms << " ms" << std::flush;
