@@ -153,6 +153,20 @@ def machine():
     return "%s, %d logical cores (nproc), %s" % (cpu, os.cpu_count(), platform.platform())
 
 
+def code_version(repo):
+    """KCT_BENCH_CODE when set (e.g. a snapshot built elsewhere), else the repo's HEAD."""
+    if os.environ.get("KCT_BENCH_CODE"):
+        return os.environ["KCT_BENCH_CODE"]
+    try:
+        commit = subprocess.run(["git", "-C", repo, "rev-parse", "--short", "HEAD"],
+                                capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", repo, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True).stdout.strip()
+    except OSError:
+        return "unknown"
+    return "commit %s%s" % (commit, " (with uncommitted changes)" if dirty else "")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true")
@@ -242,17 +256,13 @@ def main():
         mode, len(objects), len(sequences),
         str(QUICK_FRAMES) if args.quick else "/".join("%s %d" % (o, OBJECTS[o]["frames"]) for o in objects),
         ", ".join(presets)))
+    skipped = [o for o in OBJECTS if o not in objects]
+    if skipped and not args.quick:
+        L.append("- **Not run here:** %s" % ", ".join(skipped))
     L.append("- **Command:** `%s`" % args.command)
     L.append("- **Date:** %s" % start.strftime("%Y-%m-%d %H:%M UTC"))
     L.append("- **Machine:** %s" % machine())
-    try:
-        commit = subprocess.run(["git", "-C", repo, "rev-parse", "--short", "HEAD"], capture_output=True,
-                                text=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", repo, "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True).stdout.strip()
-        L.append("- **Code:** commit %s%s" % (commit, " (with uncommitted changes)" if dirty else ""))
-    except OSError:
-        pass
+    L.append("- **Code:** %s" % code_version(repo))
     L.append("- **Duration:** %.1f min (of which %.1f min generating missing data)" % (total_s / 60, gen_s / 60))
     L.append("- **Load average** (1 min) at start / end: %.2f / %.2f on %d cores. %s" % (
         load_start[0], load_end[0], os.cpu_count(),
