@@ -1,19 +1,14 @@
 #include "klt_contour_tracker/ros/param_loader.h"
 
-#include <resource_retriever/retriever.h>
 #include <ros/names.h>
-#include <ros/package.h>
 #include <ros/param.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
-#include <fstream>
 #include <set>
 #include <sstream>
-#include <unistd.h>
 
 namespace klt_contour_tracker {
 namespace {
@@ -32,7 +27,8 @@ namespace {
   X(hop_rotation_deg) X(hop_translation) X(metropolis_temperature) X(slsqp_max_evaluations)    \
   X(random_seed)
 
-const char* const kNodeParams[] = {"mesh_resource", "mesh_scale", "initial_pose/position",
+const char* const kNodeParams[] = {"model_description", "object_link", "input_is_rectified",
+                                   "mesh_resource", "mesh_scale", "initial_pose/position",
                                    "initial_pose/orientation", "object_frame", "preset",
                                    "queue_size", "image_transport"};
 
@@ -144,8 +140,18 @@ std::string format(const std::string& v) { return "'" + v + "'"; }
 
 NodeletConfig load_config(const ros::NodeHandle& nh) {
   NodeletConfig config;
-  if (!read(nh, "mesh_resource", config.mesh_resource) || config.mesh_resource.empty())
-    fail("mesh_resource", "is required (package://, file:// or a path to a mesh file)");
+  read(nh, "model_description", config.model_description);
+  read(nh, "object_link", config.object_link);
+  read(nh, "mesh_resource", config.mesh_resource);
+  if (!config.model_description.empty()) {
+    // The URDF wins over ~mesh_resource (which the launch files always set).
+    if (config.object_link.empty())
+      fail("object_link", "is required with ~model_description (the URDF link to track)");
+  } else if (config.mesh_resource.empty()) {
+    fail("mesh_resource",
+         "is required (package://, file:// or a path to a mesh file) unless "
+         "~model_description and ~object_link give the model");
+  }
   read(nh, "mesh_scale", config.mesh_scale);
   if (!(config.mesh_scale > 0.0) || !std::isfinite(config.mesh_scale))
     fail("mesh_scale", "must be a positive finite number, got " + format(config.mesh_scale));
@@ -156,6 +162,7 @@ NodeletConfig load_config(const ros::NodeHandle& nh) {
   if (config.queue_size < 1)
     fail("queue_size", "must be >= 1, got " + std::to_string(config.queue_size));
   read(nh, "image_transport", config.image_transport);
+  read(nh, "input_is_rectified", config.input_is_rectified);
 
   read(nh, "preset", config.preset);
   try {
@@ -199,8 +206,13 @@ std::string describe(const NodeletConfig& c) {
   std::ostringstream s;
   const Eigen::Quaterniond q(c.initial_pose.rotation());
   const Eigen::Vector3d t = c.initial_pose.translation();
-  s << "  mesh_resource: " << format(c.mesh_resource) << "\n"
-    << "  mesh_scale: " << c.mesh_scale << "\n"
+  if (!c.model_description.empty())
+    s << "  model_description: <URDF, " << c.model_description.size() << " characters>\n"
+      << "  object_link: " << format(c.object_link) << "\n";
+  else
+    s << "  mesh_resource: " << format(c.mesh_resource) << "\n"
+      << "  mesh_scale: " << c.mesh_scale << "\n";
+  s << "  input_is_rectified: " << format(c.input_is_rectified) << "\n"
     << "  initial_pose/position: [" << t.x() << ", " << t.y() << ", " << t.z() << "]  # m\n"
     << "  initial_pose/orientation: [" << q.x() << ", " << q.y() << ", " << q.z() << ", "
     << q.w() << "]  # x y z w\n"
@@ -214,43 +226,6 @@ std::string describe(const NodeletConfig& c) {
   std::string out = s.str();
   if (!out.empty()) out.pop_back();
   return out;
-}
-
-std::string resolve_mesh_resource(const std::string& resource) {
-  const std::string file_scheme = "file://";
-  const std::string package_scheme = "package://";
-  if (resource.rfind(file_scheme, 0) == 0) return resource.substr(file_scheme.size());
-  if (resource.find("://") == std::string::npos) return resource;
-  if (resource.rfind(package_scheme, 0) == 0) {
-    const std::string rest = resource.substr(package_scheme.size());
-    const std::size_t slash = rest.find('/');
-    const std::string package = rest.substr(0, slash);
-    const std::string package_path = ros::package::getPath(package);
-    if (package_path.empty()) fail("mesh_resource", "package '" + package + "' not found");
-    return slash == std::string::npos ? package_path : package_path + rest.substr(slash);
-  }
-  // Remote resource (http://...): fetch it into a temporary file assimp can open.
-  resource_retriever::MemoryResource memory;
-  try {
-    resource_retriever::Retriever retriever;
-    memory = retriever.get(resource);
-  } catch (const resource_retriever::Exception& e) {
-    fail("mesh_resource", std::string("cannot retrieve: ") + e.what());
-  }
-  const std::size_t dot = resource.find_last_of('.');
-  const std::string extension =
-      dot == std::string::npos || resource.find('/', dot) != std::string::npos ? ""
-                                                                               : resource.substr(dot);
-  std::string path_template = "/tmp/klt_contour_tracker_meshXXXXXX" + extension;
-  std::vector<char> buffer(path_template.begin(), path_template.end());
-  buffer.push_back('\0');
-  const int fd = mkstemps(buffer.data(), static_cast<int>(extension.size()));
-  if (fd < 0) fail("mesh_resource", "cannot create a temporary file for the download");
-  const bool written =
-      write(fd, memory.data.get(), memory.size) == static_cast<ssize_t>(memory.size);
-  close(fd);
-  if (!written) fail("mesh_resource", "cannot write the downloaded mesh to a temporary file");
-  return std::string(buffer.data());
 }
 
 }  // namespace klt_contour_tracker

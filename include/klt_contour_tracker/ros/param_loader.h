@@ -23,8 +23,11 @@ class ConfigError : public std::invalid_argument {
 
 /// The nodelet's configuration (see config/tracker.yaml for every parameter and its unit).
 struct NodeletConfig {
-  std::string mesh_resource;           ///< ~mesh_resource: package://, file:// or a plain path
-  double mesh_scale = 1.0;             ///< ~mesh_scale: model units -> metres
+  std::string model_description;  ///< ~model_description: URDF XML; when set it gives the model
+  std::string object_link;        ///< ~object_link: the URDF link tracked (frame = object frame)
+  std::string mesh_resource;      ///< ~mesh_resource: package://, file:// or a plain path (no URDF)
+  double mesh_scale = 1.0;        ///< ~mesh_scale: model units -> metres (~mesh_resource only)
+  bool input_is_rectified = true;  ///< ~input_is_rectified: true: P, no distortion; false: K and D
   kct::Pose initial_pose = kct::Pose::Identity();  ///< ~initial_pose: object_to_camera, metres
   std::string object_frame = "object";  ///< ~object_frame: child frame of the published tf
   std::string preset = "paper";        ///< ~preset: kct::make_preset() name
@@ -42,11 +45,5 @@ std::vector<std::string> unknown_parameters(const ros::NodeHandle& private_nh);
 
 /// Multi-line "name: value" listing of the whole configuration, for the start-up echo.
 std::string describe(const NodeletConfig& config);
-
-/// Local file for a mesh resource: file:// URLs and plain paths are returned as paths and
-/// package:// URLs are resolved through the package path, so that assimp finds textures next to
-/// the model; any other URL is fetched with resource_retriever into a temporary file with the
-/// same extension. Throws ConfigError ("~mesh_resource: ...") when it cannot be resolved.
-std::string resolve_mesh_resource(const std::string& resource);
 
 }  // namespace klt_contour_tracker
