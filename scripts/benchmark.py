@@ -153,6 +153,36 @@ def machine():
     return "%s, %d logical cores (nproc), %s" % (cpu, os.cpu_count(), platform.platform())
 
 
+README_BEGIN = "<!-- benchmark headline: written by scripts/benchmark.sh -->"
+README_END = "<!-- end of benchmark headline -->"
+
+
+def update_readme(repo, page):
+    """Copies the page's per-object AUC table and run line into README.md's marked block."""
+    readme = os.path.join(repo, "README.md")
+    text = open(readme).read()
+    if README_BEGIN not in text or README_END not in text:
+        return
+    lines = page.splitlines()
+    table = []
+    i = lines.index(next(l for l in lines if l.startswith("## AUC per object")))
+    for l in lines[i + 1:]:
+        if l.startswith("|"):
+            table.append(l)
+        elif table:
+            break
+    info = dict((l.split(":**")[0][4:], l.split(":**", 1)[1].strip()) for l in lines if l.startswith("- **") and ":**" in l)
+    block = [README_BEGIN, "",
+             "Latest results (%s run, %s, %s; AUC of 20, higher is better; full tables in "
+             "[docs/benchmarks.md](docs/benchmarks.md)):" % (
+                 info.get("Mode", "?").split(" ")[0], info.get("Date", "?"), info.get("Machine", "?").split(",")[0]),
+             ""] + table + ["", "![success curves](docs/benchmarks/overall.png)", "", README_END]
+    start = text.index(README_BEGIN)
+    end = text.index(README_END) + len(README_END)
+    with open(readme, "w") as f:
+        f.write(text[:start] + "\n".join(block) + text[end:])
+
+
 def code_version(repo):
     """KCT_BENCH_CODE when set (e.g. a snapshot built elsewhere), else the repo's HEAD."""
     if os.environ.get("KCT_BENCH_CODE"):
@@ -379,6 +409,7 @@ def main():
        ", ".join(seq_name(g, s) for g, s in QUICK_SEQUENCES), QUICK_FRAMES))
     with open(os.path.join(docs, "benchmarks.md"), "w") as f:
         f.write("\n".join(L) + "\n")
+    update_readme(repo, "\n".join(L))
     with open(os.path.join(results, "rows_%s.json" % mode), "w") as f:
         json.dump([{k: v for k, v in r.items() if k != "normalized_errors"} for r in rows], f, indent=1)
     log("benchmark: wrote %s (%d runs, %.1f min)" % (os.path.join(docs, "benchmarks.md"), len(rows), total_s / 60))
