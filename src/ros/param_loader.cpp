@@ -155,7 +155,9 @@ NodeletConfig load_config(const ros::NodeHandle& nh) {
   read(nh, "mesh_scale", config.mesh_scale);
   if (!(config.mesh_scale > 0.0) || !std::isfinite(config.mesh_scale))
     fail("mesh_scale", "must be a positive finite number, got " + format(config.mesh_scale));
-  config.initial_pose = read_initial_pose(nh);
+  // Optional: without it the nodelet waits for ~initial_pose (topic) or ~init (service).
+  if (nh.hasParam("initial_pose/position") || nh.hasParam("initial_pose/orientation"))
+    config.initial_pose = read_initial_pose(nh);
   read(nh, "object_frame", config.object_frame);
   if (config.object_frame.empty()) fail("object_frame", "must not be empty");
   read(nh, "queue_size", config.queue_size);

@@ -28,7 +28,9 @@ struct NodeletConfig {
   std::string mesh_resource;      ///< ~mesh_resource: package://, file:// or a plain path (no URDF)
   double mesh_scale = 1.0;        ///< ~mesh_scale: model units -> metres (~mesh_resource only)
   bool input_is_rectified = true;  ///< ~input_is_rectified: true: P, no distortion; false: K and D
-  kct::Pose initial_pose = kct::Pose::Identity();  ///< ~initial_pose: object_to_camera, metres
+  /// ~initial_pose/position + orientation: object_to_camera, metres; optional (identity when
+  /// unset: interface_config.h's has_initial_pose says whether it was given).
+  kct::Pose initial_pose = kct::Pose::Identity();
   std::string object_frame = "object";  ///< ~object_frame: child frame of the published tf
   std::string preset = "paper";        ///< ~preset: kct::make_preset() name
   int queue_size = 1;                  ///< ~queue_size: image/camera_info subscriber queue

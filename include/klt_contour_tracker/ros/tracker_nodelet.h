@@ -1,22 +1,39 @@
 #pragma once
 /// \file tracker_nodelet.h
 /// ROS wrapper of kct::Tracker. Subscribes `image` + `camera_info` (image_transport camera
-/// subscriber, resolved in the nodelet's namespace), publishes `~pose` (object_to_camera in the
-/// image's optical frame, header = the image's header), `~status` and the tf image frame ->
-/// ~object_frame. All work is done in the subscriber callback on the nodelet's callback queue.
+/// subscriber, resolved in the nodelet's namespace) and `~initial_pose`; serves `~init` and
+/// `~reset`; publishes `~pose`, `~pose_with_covariance` (object_to_camera in the image's optical
+/// frame, header = the image's header), `~status`, `~debug_image`, `~marker`, the tf image frame
+/// -> ~object_frame and /diagnostics. A kct::TrackQualityMonitor runs the WAITING_FOR_POSE /
+/// TRACKING / LOST state machine; while LOST the tracker re-acquires around the last good pose.
+/// All work is done in callbacks on the nodelet's single-threaded callback queue.
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/publisher.h>
+#include <dynamic_reconfigure/server.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
 
+#include <boost/thread/recursive_mutex.hpp>
 #include <memory>
+#include <optional>
 
+#include "klt_contour_tracker/Init.h"
+#include "klt_contour_tracker/TrackerConfig.h"
 #include "klt_contour_tracker/TrackerStatus.h"
+#include "klt_contour_tracker/core/contour_extractor.h"
 #include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/track_quality.h"
 #include "klt_contour_tracker/core/tracker.h"
+#include "klt_contour_tracker/ros/interface_config.h"
 #include "klt_contour_tracker/ros/param_loader.h"
 
 namespace klt_contour_tracker {
@@ -28,29 +45,81 @@ class TrackerNodelet : public nodelet::Nodelet {
   ~TrackerNodelet() override;
 
  private:
-  /// Reads the configuration and loads the mesh; on any error logs NODELET_FATAL and does not
+  /// Reads the configuration and loads the model; on any error logs NODELET_FATAL and does not
   /// subscribe (the manager and its other nodelets keep running).
   void onInit() override;
-  /// One frame: camera update, conversion, Tracker::track(), publishing.
+  /// One frame: camera update, conversion, tracking, publishing; a ~status for every image.
   void on_image(const sensor_msgs::ImageConstPtr& image,
                 const sensor_msgs::CameraInfoConstPtr& info);
-  /// Creates the tracker on the first camera_info and updates its camera when it changes.
-  /// Returns false (and logs) when the camera_info is unusable.
-  bool update_camera(const sensor_msgs::CameraInfo& info);
-  /// Converts and tracks one image whose size matches the camera; publishes pose and tf, fills
-  /// `status`.
+  /// Creates the tracker on the first usable camera_info and updates its camera when it
+  /// changes. Returns false with the reason in `error` when the camera_info is unusable.
+  bool update_camera(const sensor_msgs::CameraInfo& info, std::string& error);
+  /// Tracks one image whose size matches the camera; fills `status`, publishes the outputs.
   void track(const sensor_msgs::ImageConstPtr& image, TrackerStatus& status);
 
+  /// ~initial_pose: a PoseStamped in any frame, applied on the next image.
+  void on_initial_pose(const geometry_msgs::PoseStampedConstPtr& pose);
+  /// ~init: same as ~initial_pose, replying whether the pose is acceptable.
+  bool on_init(Init::Request& request, Init::Response& response);
+  /// ~reset: drops the track; waits for a pose.
+  bool on_reset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  /// Checks a given pose (finite, unit quaternion, tf to the camera frame when known, in front
+  /// of the camera) and queues it for the next image. Returns false with the reason.
+  bool queue_pose(const geometry_msgs::PoseStamped& pose, std::string& message);
+  /// The pose in the camera optical frame `camera_frame` at `stamp` (the pose's frame held
+  /// fixed; latest tf when `stamp` is not available). Throws std::runtime_error.
+  kct::Pose to_camera_frame(const geometry_msgs::PoseStamped& pose, const std::string& camera_frame,
+                            const ros::Time& stamp) const;
+  /// Starts tracking from `object_to_camera` on the next track() call.
+  void start_from(const kct::Pose& object_to_camera);
+
+  /// dynamic_reconfigure: a changed preset loads the preset's values into `config` (pushed back
+  /// to the server); other changes are validated and applied, or reverted with a warning.
+  void on_reconfigure(TrackerConfig& config, uint32_t level);
+  /// The reconfigurable values of the current parameters.
+  TrackerConfig reconfigure_values() const;
+
+  void publish_pose(const std_msgs::Header& header, const kct::TrackResult& result);
+  void publish_debug_image(const sensor_msgs::ImageConstPtr& image, const cv::Mat& frame,
+                           const kct::TrackResult& result, bool published);
+  /// Latched ~marker (the mesh in ~object_frame), once, stamped with the first image's stamp.
+  void publish_marker(const ros::Time& stamp);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
   NodeletConfig config_;
+  InterfaceConfig interface_;
   std::shared_ptr<const kct::Mesh> mesh_;
   std::unique_ptr<kct::Tracker> tracker_;
+  kct::TrackQualityMonitor monitor_;
   sensor_msgs::CameraInfo camera_info_;  ///< the camera the tracker currently uses
+  cv::Mat debug_map_x_, debug_map_y_;    ///< undistortion of the debug image (raw input)
   ros::Time last_stamp_;
+  std::string camera_frame_;  ///< frame_id of the last image
+  std::optional<geometry_msgs::PoseStamped> pending_pose_;  ///< applied on the next image
+  std::optional<kct::Pose> restart_pose_;  ///< re-applied on a backward time jump
+  bool marker_published_ = false;
+  // Statistics for diagnostics.
+  TrackerStatus last_status_;
+  double last_latency_s_ = 0.0;
+  std::size_t frames_ = 0;
+
   std::unique_ptr<image_transport::ImageTransport> image_transport_;
+  std::unique_ptr<image_transport::ImageTransport> private_image_transport_;
   image_transport::CameraSubscriber camera_sub_;
-  ros::Publisher pose_pub_;
-  ros::Publisher status_pub_;
+  image_transport::Publisher debug_image_pub_;
+  ros::Subscriber initial_pose_sub_;
+  ros::ServiceServer init_srv_, reset_srv_;
+  ros::Publisher pose_pub_, pose_covariance_pub_, status_pub_, marker_pub_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<TrackerConfig>> reconfigure_server_;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
+  std::unique_ptr<diagnostic_updater::TopicDiagnostic> pose_diagnostic_;
+  double diagnostic_min_rate_hz_ = 1.0, diagnostic_max_rate_hz_ = 1000.0;
+  ros::Timer diagnostic_timer_;
 };
 
 }  // namespace klt_contour_tracker
