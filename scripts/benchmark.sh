@@ -5,7 +5,8 @@
 #   scripts/benchmark.sh [--quick] [--preset NAME ...] [--objects can,chest,...] [--frames N]
 #   --quick: can and chest, 11 sequences of 30 frames each (about 4 min on 2 cores)
 #   full run: can, chest, rock, bike, can_1080p x 23 sequences (60/60/60/12/40 frames):
-#             about 45 min on 2 cores; --frames N sets every object's sequence length
+#             about 45 min on 2 idle cores; --frames N sets every object's sequence length,
+#             --track-frames N tracks only the first N frames (keeps the cached sequences)
 #   default presets: paper and klt_only (repeat --preset to choose)
 COMMAND="${KCT_WS:+KCT_WS=$KCT_WS }scripts/benchmark.sh $*"
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
@@ -19,7 +20,9 @@ while [ $# -gt 0 ]; do
                ARGS+=(--objects "$2"); shift 2 ;;
     --frames) [ $# -ge 2 ] || { echo "benchmark: --frames needs a number" >&2; exit 2; }
               ARGS+=(--frames "$2"); shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    --track-frames) [ $# -ge 2 ] || { echo "benchmark: --track-frames needs a number" >&2; exit 2; }
+              ARGS+=(--track-frames "$2"); shift 2 ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
     *) echo "benchmark: unknown argument $1" >&2; exit 2 ;;
   esac
 done
