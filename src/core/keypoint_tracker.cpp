@@ -54,7 +54,7 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
   cv::Mat mask = render.mask();
   cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE,
                                                   {2 * kMaskErosionPx + 1, 2 * kMaskErosionPx + 1}));
-  previous_gray_ = gray.clone();
+  previous_gray_ = klt_image(gray);
   if (cv::countNonZero(mask) == 0) return 0;
 
   std::vector<cv::Point2f> corners;
@@ -90,6 +90,23 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
   return detected_count_;
 }
 
+cv::Mat KeypointTracker::klt_image(const cv::Mat& gray) const {
+  const int side = params_.klt_illumination_window_px;
+  if (side <= 0) return gray.clone();
+  // Local gain/offset normalization: (I - mean) / std over a side x side box. A lighting
+  // change that is smooth over the window (a flash, a moving lamp) cancels out.
+  cv::Mat intensity, mean, mean_of_squares;
+  gray.convertTo(intensity, CV_32F);
+  const cv::Size box(side, side);
+  cv::boxFilter(intensity, mean, CV_32F, box);
+  cv::boxFilter(intensity.mul(intensity), mean_of_squares, CV_32F, box);
+  cv::Mat deviation;
+  cv::sqrt(cv::max(mean_of_squares - mean.mul(mean), 0.0) + 16.0, deviation);  // >= 4 levels
+  cv::Mat normalized;
+  cv::Mat((intensity - mean) / deviation * 40.0 + 128.0).convertTo(normalized, CV_8U);
+  return normalized;
+}
+
 bool KeypointTracker::needs_redetection() const {
   return detected_count_ == 0 ||
          static_cast<double>(image_points_.size()) < params_.redetect_ratio * detected_count_;
@@ -99,7 +116,7 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
                                       const PinholeCamera& camera) {
   KeypointResult result;
   if (image_points_.empty() || previous_gray_.empty() || previous_gray_.size() != gray.size()) {
-    previous_gray_ = gray.clone();
+    previous_gray_ = klt_image(gray);
     image_points_.clear();
     object_points_.clear();
     return result;
@@ -111,7 +128,8 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   std::vector<cv::Mat> previous_pyramid, current_pyramid;
   cv::buildOpticalFlowPyramid(previous_gray_, previous_pyramid, window, params_.klt_pyramid_levels);
-  cv::buildOpticalFlowPyramid(gray, current_pyramid, window, params_.klt_pyramid_levels);
+  const cv::Mat current = klt_image(gray);
+  cv::buildOpticalFlowPyramid(current, current_pyramid, window, params_.klt_pyramid_levels);
   std::vector<cv::Point2f> forward, backward;
   std::vector<uchar> status_forward, status_backward;
   std::vector<float> error;
@@ -133,7 +151,7 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
     tracked_image.push_back(forward[i]);
     tracked_object.push_back(object_points_[i]);
   }
-  previous_gray_ = gray.clone();
+  previous_gray_ = current;
   image_points_ = tracked_image;
   object_points_ = tracked_object;
   result.tracked = static_cast<int>(tracked_image.size());

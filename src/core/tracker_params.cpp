@@ -28,6 +28,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
 #define KCT_FIELD(name) {#name, &TrackerParams::name}
       KCT_FIELD(max_keypoints), KCT_FIELD(corner_quality_level), KCT_FIELD(corner_min_distance_px),
       KCT_FIELD(klt_window_px), KCT_FIELD(klt_pyramid_levels), KCT_FIELD(klt_forward_backward_px),
+      KCT_FIELD(klt_illumination_window_px),
       KCT_FIELD(ransac_reprojection_px), KCT_FIELD(ransac_iterations), KCT_FIELD(klt_min_points),
       KCT_FIELD(klt_min_inlier_ratio), KCT_FIELD(redetect_ratio), KCT_FIELD(redetect_interval_frames),
       KCT_FIELD(redetect_max_reprojection_increase_px),
@@ -98,6 +99,7 @@ void TrackerParams::validate() const {
     throw std::invalid_argument("TrackerParams.klt_window_px must be odd");
   check_range("klt_pyramid_levels", klt_pyramid_levels, 0, 8);
   check_range("klt_forward_backward_px", klt_forward_backward_px, 0.01, 100.0);
+  check_range("klt_illumination_window_px", klt_illumination_window_px, 0, 501);
   check_range("ransac_reprojection_px", ransac_reprojection_px, 0.1, 100.0);
   check_range("ransac_iterations", ransac_iterations, 1, 100000);
   check_range("klt_min_points", klt_min_points, 4, 100000);

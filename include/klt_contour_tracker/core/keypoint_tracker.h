@@ -57,6 +57,10 @@ class KeypointTracker {
   void set_params(const TrackerParams& params) { params_ = params; }
 
  private:
+  /// The frame KLT tracks on: `gray` normalized to zero mean / unit variance over
+  /// klt_illumination_window_px windows (or a copy of `gray` when the window is 0).
+  cv::Mat klt_image(const cv::Mat& gray) const;
+
   std::shared_ptr<const Mesh> mesh_;
   Renderer renderer_;
   TrackerParams params_;

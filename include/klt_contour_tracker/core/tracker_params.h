@@ -19,6 +19,10 @@ struct TrackerParams {
   int klt_window_px = 21;                  ///< ours: LK window side, px (odd)
   int klt_pyramid_levels = 3;              ///< ours: LK pyramid levels above the base
   double klt_forward_backward_px = 1.0;    ///< ours: max forward-backward error of a track, px
+  /// ours: KLT runs on frames normalized to zero mean and unit variance over windows of this
+  /// side, px (0 = raw frames), so that a light switched on or moved (OPT's flash and moving
+  /// light groups) does not break the brightness-constancy assumption of Lucas-Kanade.
+  int klt_illumination_window_px = 15;
   double ransac_reprojection_px = 3.0;     ///< ours: RANSAC inlier threshold, px
   int ransac_iterations = 200;             ///< ours: RANSAC iterations
   int klt_min_points = 8;                  ///< paper: KLT fails below this many tracked points
