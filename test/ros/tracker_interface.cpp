@@ -2,6 +2,7 @@
 // ~init / ~initial_pose / ~reset, an initial pose in a world frame through tf, LOST and
 // re-acquisition when the object is hidden for a stretch of frames, and bad input (each reported
 // in ~status while the node keeps tracking the next good frame).
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
@@ -321,6 +322,41 @@ TEST(TrackerInterface, LostWhileHiddenAndReacquiredWhenTheObjectComesBack) {
   // Tolerance: 5 mm and 3 deg after re-acquisition (coarse visibility table).
   EXPECT_LT(kct::translation_error(final_pose, truth), 0.005);
   EXPECT_LT(kct::rotation_error_deg(final_pose, truth), 3.0);
+
+  // dynamic_reconfigure: choosing a preset pushes its values back (klt_only: no refinement);
+  // an invalid value (an even KLT window) is rejected and the values in use are shown.
+  auto reconfigure = [&](const std::function<void(dynamic_reconfigure::Config&)>& fill) {
+    dynamic_reconfigure::Reconfigure srv;
+    fill(srv.request.config);
+    EXPECT_TRUE(ros::service::call(harness.name() + "/set_parameters", srv));
+    return srv.response.config;
+  };
+  auto find_bool = [](const dynamic_reconfigure::Config& c, const std::string& name) {
+    for (const auto& b : c.bools) if (b.name == name) return static_cast<int>(b.value);
+    return -1;
+  };
+  auto find_int = [](const dynamic_reconfigure::Config& c, const std::string& name) {
+    for (const auto& i : c.ints) if (i.name == name) return i.value;
+    return -1;
+  };
+  dynamic_reconfigure::Config config = reconfigure([](dynamic_reconfigure::Config& c) {
+    dynamic_reconfigure::StrParameter preset;
+    preset.name = "preset";
+    preset.value = "klt_only";
+    c.strs.push_back(preset);
+  });
+  EXPECT_EQ(find_bool(config, "refine"), 0) << "the klt_only preset was not pushed back";
+  config = reconfigure([](dynamic_reconfigure::Config& c) {
+    dynamic_reconfigure::IntParameter window;
+    window.name = "klt_window_px";
+    window.value = 16;
+    c.ints.push_back(window);
+  });
+  EXPECT_EQ(find_int(config, "klt_window_px"), 21) << "an even KLT window must be rejected";
+  const auto after = send(true, 300);
+  ASSERT_TRUE(after);
+  EXPECT_FALSE(after->refined);
+  EXPECT_EQ(after->state, "keypoints");
 }
 
 }  // namespace
