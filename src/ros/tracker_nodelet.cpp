@@ -3,7 +3,6 @@
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <pluginlib/class_list_macros.hpp>
-#include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/Marker.h>
 
 #include <algorithm>

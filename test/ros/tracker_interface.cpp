@@ -2,6 +2,7 @@
 // ~init / ~initial_pose / ~reset, an initial pose in a world frame through tf, LOST and
 // re-acquisition when the object is hidden for a stretch of frames, and bad input (each reported
 // in ~status while the node keeps tracking the next good frame).
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <std_srvs/Trigger.h>
@@ -357,6 +358,38 @@ TEST(TrackerInterface, LostWhileHiddenAndReacquiredWhenTheObjectComesBack) {
   ASSERT_TRUE(after);
   EXPECT_FALSE(after->refined);
   EXPECT_EQ(after->state, "keypoints");
+}
+
+// /diagnostics: the tracking state and the ~pose topic's rate and stamp age.
+TEST(TrackerInterface, DiagnosticsReportTheStateAndThePoseTopic) {
+  Shared& s = shared();
+  ASSERT_TRUE(s.harness.ready());
+  std::mutex mutex;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> latest;
+  ros::NodeHandle nh;
+  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const auto& status : m->status) latest[status.name] = status;
+      });
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(s.step());
+  ASSERT_TRUE(wait_for([&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return latest.count("tracker: tracking") && latest.count("tracker: pose topic status");
+  }, 10.0));
+  std::lock_guard<std::mutex> lock(mutex);
+  const auto& tracking = latest.at("tracker: tracking");
+  EXPECT_EQ(tracking.level, diagnostic_msgs::DiagnosticStatus::OK) << tracking.message;
+  EXPECT_EQ(tracking.hardware_id, "crate");
+  bool has_state = false;
+  for (const auto& kv : tracking.values)
+    if (kv.key == "state") has_state = kv.value == "tracking";
+  EXPECT_TRUE(has_state);
+  bool has_rate = false;
+  for (const auto& kv : latest.at("tracker: pose topic status").values)
+    has_rate = has_rate || kv.key.find("frequency") != std::string::npos ||
+               kv.key.find("Frequency") != std::string::npos;
+  EXPECT_TRUE(has_rate);
 }
 
 }  // namespace
