@@ -1,8 +1,19 @@
 #!/usr/bin/env bash
 # Builds the package (and its tests) in a catkin workspace under build/ws (git-ignored).
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-mkdir -p "$KCT_WS/src"
-ln -sfn "$KCT_ROOT" "$KCT_WS/src/klt_contour_tracker"
+# The workspace's package folder links every top-level entry of the repository except build/
+# and data/: a link to the repository root itself would be a loop (build/ws/src/pkg/build/ws/...)
+# that roslaunch's launch-file search follows forever.
+pkg_dir="$KCT_WS/src/klt_contour_tracker"
+[ -L "$pkg_dir" ] && rm "$pkg_dir"
+mkdir -p "$pkg_dir"
+find "$pkg_dir" -maxdepth 1 -type l -delete
+for entry in "$KCT_ROOT"/* "$KCT_ROOT"/.clang-format; do
+  [ -e "$entry" ] || continue
+  name="$(basename "$entry")"
+  case "$name" in build|data) continue ;; esac
+  ln -s "$entry" "$pkg_dir/$name"
+done
 cd "$KCT_WS"
 jobs="${KCT_JOBS:-$(nproc)}"
 log "build: catkin_make (Release, -j$jobs)"
