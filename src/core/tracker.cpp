@@ -99,6 +99,17 @@ const ContourExtractor* Tracker::contour_extractor() const {
   return refiner_ ? &refiner_->contour_extractor() : nullptr;
 }
 
+void Tracker::apply_refinement(const RefineResult& refined, TrackResult& result) {
+  // A refined pose that is not a rigid transform in front of the camera is not used.
+  if (is_valid_pose(refined.object_to_camera) && refined.object_to_camera.translation().z() > 0) {
+    result.object_to_camera = refined.object_to_camera;
+    result.refined = true;
+  }
+  result.energy_before = refined.energy_before;
+  result.energy_after = refined.energy_after;
+  result.hops = refined.hops;
+}
+
 std::string Tracker::check_frame(const Frame& frame) const {
   if (frame.image.empty()) return "empty image";
   if (frame.image.depth() != CV_8U || (frame.image.channels() != 1 && frame.image.channels() != 3))
@@ -139,13 +150,7 @@ TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double se
         throw;
       }
       refiner_->set_params(params_);
-      if (is_valid_pose(refined.object_to_camera) && refined.object_to_camera.translation().z() > 0) {
-        result.object_to_camera = refined.object_to_camera;
-        result.refined = true;
-      }
-      result.energy_before = refined.energy_before;
-      result.energy_after = refined.energy_after;
-      result.hops = refined.hops;
+      apply_refinement(refined, result);
     }
     pose_i1_ = pose_i2_ = result.object_to_camera;
     keypoints_.clear();
@@ -202,13 +207,7 @@ TrackResult Tracker::track(const Frame& frame) {
     const RefineResult refined =
         refiner_->refine(gray, camera_, result.preliminary_object_to_camera,
                          result.keypoints.success ? &result.keypoints : nullptr);
-    if (is_valid_pose(refined.object_to_camera) && refined.object_to_camera.translation().z() > 0) {
-      result.object_to_camera = refined.object_to_camera;
-      result.refined = true;
-    }
-    result.energy_before = refined.energy_before;
-    result.energy_after = refined.energy_after;
-    result.hops = refined.hops;
+    apply_refinement(refined, result);
   }
 
   // The frame's final pose seeds the extrapolation and the keypoint re-detection, so that

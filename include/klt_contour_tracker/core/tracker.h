@@ -17,6 +17,7 @@
 namespace kct {
 
 class PoseRefiner;
+struct RefineResult;
 class ContourExtractor;
 
 /// One camera image. 8-bit grey (CV_8UC1) or BGR (CV_8UC3); undistorted unless the camera
@@ -92,6 +93,8 @@ class Tracker {
 
  private:
   enum class State { kWaiting, kPendingFirstFrame, kTracking };
+  /// Copies a refinement's pose (when valid) and statistics into `result`.
+  static void apply_refinement(const RefineResult& refined, TrackResult& result);
   cv::Mat to_gray(const cv::Mat& image) const;
   /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
   std::string check_frame(const Frame& frame) const;
