@@ -173,9 +173,10 @@ def update_readme(repo, page):
             break
     info = dict((l.split(":**")[0][4:], l.split(":**", 1)[1].strip()) for l in lines if l.startswith("- **") and ":**" in l)
     block = [README_BEGIN, "",
-             "Latest results (%s run, %s, %s; AUC of 20, higher is better; full tables in "
-             "[docs/benchmarks.md](docs/benchmarks.md)):" % (
-                 info.get("Mode", "?").split(" ")[0], info.get("Date", "?"), info.get("Machine", "?").split(",")[0]),
+             "Latest results: %s run (%s), %s, %s. AUC of 20, higher is better; all tables, "
+             "timings and plots in [docs/benchmarks.md](docs/benchmarks.md)." % (
+                 info.get("Mode", "?").split(" ")[0], info.get("Mode", "?").split(" ", 1)[-1].strip("()"),
+                 info.get("Date", "?"), info.get("Machine", "?").split(",")[0]),
              ""] + table + ["", "![success curves](docs/benchmarks/overall.png)", "", README_END]
     start = text.index(README_BEGIN)
     end = text.index(README_END) + len(README_END)
@@ -281,7 +282,8 @@ def main():
                 for g in groups])
 
     # Page.
-    mode = "quick" if args.quick else "full"
+    partial = args.track_frames or any(o not in objects for o in OBJECTS)
+    mode = "quick" if args.quick else ("partial" if partial else "full")
     L = []
     L.append("# Benchmarks\n")
     L.append("OPT-style synthetic benchmark (the paper's Sec. 4 evaluates on the OPT dataset, which "
