@@ -44,7 +44,7 @@ cv::Scalar palette(int i) {
 }
 
 void plot(const std::vector<Curve>& curves, const std::string& title, double k_max, const std::string& output) {
-  const int width = 720, height = 460, left = 60, right = 210, top = 36, bottom = 48;
+  const int width = 760, height = 460, left = 60, right = 250, top = 36, bottom = 48;
   const int pw = width - left - right, ph = height - top - bottom;
   cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   auto to_px = [&](double k, double success) {
