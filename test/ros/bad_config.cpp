@@ -6,7 +6,10 @@
 #include <ros/ros.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <set>
@@ -16,6 +19,16 @@
 namespace {
 
 const std::string kMesh = std::string("file://") + KCT_SOURCE_DIR "/models/demo_crate.obj";
+const std::string kUrdf =
+    "<robot name='crate'><link name='crate'><visual><geometry><mesh filename='" + kMesh +
+    "'/></geometry></visual></link></robot>";
+
+/// An .obj file that is not a mesh, written once for the test.
+std::string corrupt_mesh_path() {
+  const std::string path = "/tmp/kct_bad_config_corrupt_" + std::to_string(::getpid()) + ".obj";
+  std::ofstream(path) << "this is not a mesh \x01\x02\n f 1 2 99\n";
+  return path;
+}
 
 /// Topics someone subscribes to, from the master (getSystemState).
 std::set<std::string> subscribed_topics() {
@@ -67,6 +80,21 @@ TEST(BadConfig, ReportedWithoutSubscriptionAndManagerKeepsRunning) {
        [](ros::NodeHandle& nh) {
          nh.setParam("initial_pose/position", std::vector<double>{0.0, 0.0, -0.5});
        }},
+      {"urdf_without_link",
+       [](ros::NodeHandle& nh) {
+         nh.setParam("model_description", kUrdf);
+         nh.setParam("object_link", "no_such_link");
+       }},
+      {"urdf_without_object_link", [](ros::NodeHandle& nh) { nh.setParam("model_description", kUrdf); }},
+      {"broken_urdf", [](ros::NodeHandle& nh) {
+         nh.setParam("model_description", std::string("<robot name='x'><link"));
+         nh.setParam("object_link", "crate");
+       }},
+      {"missing_package",
+       [](ros::NodeHandle& nh) {
+         nh.setParam("mesh_resource", "package://no_such_package_kct/meshes/x.obj");
+       }},
+      {"corrupt_mesh", [](ros::NodeHandle& nh) { nh.setParam("mesh_resource", corrupt_mesh_path()); }},
       {"nan_pose",
        [](ros::NodeHandle& nh) {
          nh.setParam("initial_pose/position",
