@@ -7,25 +7,13 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <iomanip>
 #include <set>
 #include <sstream>
 
 namespace klt_contour_tracker {
 namespace {
-
-// Every kct::TrackerParams field; the ROS parameter name is the field name. Keep in sync with
-// tracker_params.h (a field missing here can only be set through the preset).
-#define KCT_TRACKER_PARAM_FIELDS(X)                                                            \
-  X(max_keypoints) X(corner_quality_level) X(corner_min_distance_px) X(klt_window_px)          \
-  X(klt_pyramid_levels) X(klt_forward_backward_px) X(ransac_reprojection_px)                   \
-  X(ransac_iterations) X(klt_min_points) X(klt_min_inlier_ratio) X(redetect_ratio)             \
-  X(redetect_interval_frames) X(refine) X(sharp_edge_angle_deg) X(icosphere_subdivisions)      \
-  X(visibility_resolution_px) X(visibility_cache_dir) X(contour_sample_spacing_px)             \
-  X(blur_sigma_px) X(final_hops) X(hops_budget) X(min_hops_cap)                                \
-  X(max_hops_without_improvement_cap) X(max_hops_cap) X(max_reprojection_increase_px)          \
-  X(extrapolated_rotation_bound_deg) X(extrapolated_axial_bound) X(extrapolated_lateral_bound) \
-  X(hop_rotation_deg) X(hop_translation) X(metropolis_temperature) X(slsqp_max_evaluations)    \
-  X(random_seed)
 
 const char* const kNodeParams[] = {"model_description", "object_link", "input_is_rectified",
                                    "mesh_resource", "mesh_scale", "initial_pose/position",
@@ -71,14 +59,6 @@ bool read(const ros::NodeHandle& nh, const std::string& name, int& out) {
   return true;
 }
 
-bool read(const ros::NodeHandle& nh, const std::string& name, std::uint32_t& out) {
-  int value = 0;
-  if (!read(nh, name, value)) return false;
-  if (value < 0) fail(name, "must be >= 0, got " + std::to_string(value));
-  out = static_cast<std::uint32_t>(value);
-  return true;
-}
-
 bool read(const ros::NodeHandle& nh, const std::string& name, bool& out) {
   XmlRpc::XmlRpcValue v;
   if (!nh.getParam(name, v)) return false;
@@ -92,6 +72,32 @@ bool read(const ros::NodeHandle& nh, const std::string& name, std::string& out) 
   if (!nh.getParam(name, v)) return false;
   if (v.getType() != XmlRpc::XmlRpcValue::TypeString) wrong_type(name, "a string", v);
   out = static_cast<std::string>(v);
+  return true;
+}
+
+/// Reads ~<name> for the kct::TrackerParams field of that name (kct::set_param parses and
+/// type-checks it). Returns false when the parameter is not set.
+bool read_tracker_field(const ros::NodeHandle& nh, const std::string& name, kct::TrackerParams& out) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.getParam(name, v)) return false;
+  std::string text;
+  switch (v.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean: text = static_cast<bool>(v) ? "true" : "false"; break;
+    case XmlRpc::XmlRpcValue::TypeInt: text = std::to_string(static_cast<int>(v)); break;
+    case XmlRpc::XmlRpcValue::TypeDouble: {
+      std::ostringstream number;
+      number << std::setprecision(17) << static_cast<double>(v);
+      text = number.str();
+      break;
+    }
+    case XmlRpc::XmlRpcValue::TypeString: text = static_cast<std::string>(v); break;
+    default: wrong_type(name, "a boolean, a number or a string", v);
+  }
+  try {
+    kct::set_param(out, name, text);
+  } catch (const std::invalid_argument& e) {
+    fail(name, e.what());
+  }
   return true;
 }
 
@@ -126,13 +132,18 @@ kct::Pose read_initial_pose(const ros::NodeHandle& nh) {
   return kct::pose_from_quaternion(p[0], p[1], p[2], q[0], q[1], q[2], q[3]);
 }
 
+/// $ROS_HOME, else ~/.ros (where roslaunch keeps its logs).
+std::string ros_home() {
+  if (const char* home = std::getenv("ROS_HOME"); home && *home) return home;
+  const char* user_home = std::getenv("HOME");
+  return std::string(user_home && *user_home ? user_home : "/tmp") + "/.ros";
+}
+
 std::string format(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
 }
-std::string format(int v) { return std::to_string(v); }
-std::string format(std::uint32_t v) { return std::to_string(v); }
 std::string format(bool v) { return v ? "true" : "false"; }
 std::string format(const std::string& v) { return "'" + v + "'"; }
 
@@ -172,9 +183,11 @@ NodeletConfig load_config(const ros::NodeHandle& nh) {
   } catch (const std::invalid_argument& e) {
     fail("preset", e.what());
   }
-#define KCT_READ_FIELD(field) read(nh, #field, config.params.field);
-  KCT_TRACKER_PARAM_FIELDS(KCT_READ_FIELD)
-#undef KCT_READ_FIELD
+  for (const auto& field : kct::describe(config.params))
+    read_tracker_field(nh, field.first, config.params);
+  // A second start with the same model loads the visibility table from here (seconds saved).
+  if (!nh.hasParam("visibility_cache_dir"))
+    config.params.visibility_cache_dir = ros_home() + "/klt_contour_tracker/visibility";
   try {
     config.params.validate();
   } catch (const std::invalid_argument& e) {
@@ -189,9 +202,7 @@ NodeletConfig load_config(const ros::NodeHandle& nh) {
 
 std::vector<std::string> unknown_parameters(const ros::NodeHandle& nh) {
   std::set<std::string> known(std::begin(kNodeParams), std::end(kNodeParams));
-#define KCT_KNOWN_FIELD(field) known.insert(#field);
-  KCT_TRACKER_PARAM_FIELDS(KCT_KNOWN_FIELD)
-#undef KCT_KNOWN_FIELD
+  for (const auto& field : kct::describe(kct::TrackerParams{})) known.insert(field.first);
   std::vector<std::string> all;
   std::vector<std::string> unknown;
   if (!ros::param::getParamNames(all)) return unknown;
@@ -222,9 +233,7 @@ std::string describe(const NodeletConfig& c) {
     << "  queue_size: " << c.queue_size << "\n"
     << "  image_transport: " << format(c.image_transport) << "\n"
     << "  preset: " << format(c.preset) << "\n";
-#define KCT_DESCRIBE_FIELD(field) s << "  " #field ": " << format(c.params.field) << "\n";
-  KCT_TRACKER_PARAM_FIELDS(KCT_DESCRIBE_FIELD)
-#undef KCT_DESCRIBE_FIELD
+  for (const auto& [name, value] : kct::describe(c.params)) s << "  " << name << ": " << value << "\n";
   std::string out = s.str();
   if (!out.empty()) out.pop_back();
   return out;

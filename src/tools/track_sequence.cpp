@@ -28,6 +28,8 @@ void usage(const char* error) {
                "                      [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]\n"
                "                      [--max-frames N] [--errors FILE] [--debug-dir DIR [--debug-every N]]\n"
                "                      [--quiet]\n"
+               "  The visibility table is cached in $XDG_CACHE_HOME (~/.cache)/klt_contour_tracker/visibility\n"
+               "  (--param visibility_cache_dir=DIR to change, =\"\" for none).\n"
                "  --errors FILE writes the per-frame error delta_i (Sec. 4.1, model units), one a line.\n"
                "  --debug-dir DIR writes the tracking overlay (contour, keypoints, axes, status) of every\n"
                "  N-th frame (default 1) as DIR/<frame>.png.\n"
@@ -89,6 +91,12 @@ int main(int argc, char** argv) {
   const Options options = parse(argc, argv);
   try {
     kct::TrackerParams params = kct::make_preset(options.preset);
+    // The visibility table is cached per model: a second run on the same model starts at once.
+    if (const char* home = std::getenv("HOME"); home && *home) {
+      const char* xdg = std::getenv("XDG_CACHE_HOME");
+      params.visibility_cache_dir = (xdg && *xdg ? std::string(xdg) : std::string(home) + "/.cache") +
+                                    "/klt_contour_tracker/visibility";
+    }
     for (const auto& [name, value] : options.overrides) kct::set_param(params, name, value);
     params.validate();
 
