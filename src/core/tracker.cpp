@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "klt_contour_tracker/core/pose_refiner.h"
+#include "klt_contour_tracker/core/search_area.h"
 
 namespace kct {
 
@@ -85,14 +86,12 @@ bool Tracker::keypoints_agree_with(const TrackResult& result) const {
   if (!result.refined || !result.keypoints.success) return true;
   const KeypointInliers& inliers = result.keypoints.inlier_points;
   if (inliers.points_object.empty()) return true;
-  auto mean_error_px = [&](const Pose& pose) {
-    double sum = 0.0;
-    for (size_t i = 0; i < inliers.points_object.size(); ++i)
-      sum += (camera_.project(pose * inliers.points_object[i]) - inliers.points_image[i]).norm();
-    return sum / inliers.points_object.size();
-  };
-  return mean_error_px(result.object_to_camera) - mean_error_px(result.keypoints.object_to_camera) <=
-         params_.redetect_max_reprojection_increase_px;
+  // The search area's constraint (Sec. 3.4) with a tighter bound: <= 0 when the mean
+  // reprojection error grew by at most redetect_max_reprojection_increase_px.
+  const ReprojectionConstraint agreement(inliers.points_object, inliers.points_image, camera_,
+                                         result.keypoints.object_to_camera,
+                                         params_.redetect_max_reprojection_increase_px);
+  return agreement(result.object_to_camera) <= 0.0;
 }
 
 const ContourExtractor* Tracker::contour_extractor() const {
