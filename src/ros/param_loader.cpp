@@ -96,7 +96,11 @@ bool read_tracker_field(const ros::NodeHandle& nh, const std::string& name, kct:
   try {
     kct::set_param(out, name, text);
   } catch (const std::invalid_argument& e) {
-    fail(name, e.what());
+    // set_param says "TrackerParams.<name>: <reason>"; fail() names the ROS parameter.
+    std::string reason = e.what();
+    const std::string prefix = "TrackerParams." + name + ": ";
+    if (reason.rfind(prefix, 0) == 0) reason = reason.substr(prefix.size());
+    fail(name, reason);
   }
   return true;
 }
