@@ -155,6 +155,14 @@ bool TrackerNodelet::update_camera(const sensor_msgs::CameraInfo& info, std::str
   return true;
 }
 
+void TrackerNodelet::warn_skipped(const std::string& reason) {
+  const ros::WallTime now = ros::WallTime::now();
+  if (reason == last_skip_reason_ && (now - last_skip_log_).toSec() < 5.0) return;
+  NODELET_WARN("skipping frame: %s", reason.c_str());
+  last_skip_reason_ = reason;
+  last_skip_log_ = now;
+}
+
 void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image,
                               const sensor_msgs::CameraInfoConstPtr& info) {
   const auto start = std::chrono::steady_clock::now();
@@ -164,7 +172,7 @@ void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image,
   status->header = image->header;
   status->state = kct::to_string(kct::TrackStatus::kInvalidInput);
   auto skip = [&](const std::string& reason) {
-    NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", reason.c_str());
+    warn_skipped(reason);
     status->message = reason;
   };
   try {
@@ -204,7 +212,7 @@ void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatu
   try {
     frame.image = image_for_tracker(image);
   } catch (const std::exception& e) {
-    NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", e.what());
+    warn_skipped(e.what());
     status.message = e.what();
     return;
   }
@@ -275,7 +283,7 @@ void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatu
   status.good = has_pose(result) && monitor_.last_good();
 
   if (result.status == kct::TrackStatus::kInvalidInput) {
-    NODELET_WARN_THROTTLE(5.0, "skipping frame: %s", result.message.c_str());
+    warn_skipped(result.message);
     return;
   }
   if (result.status == kct::TrackStatus::kExtrapolated) {

@@ -94,6 +94,11 @@ class TrackerNodelet : public nodelet::Nodelet {
   sensor_msgs::CameraInfo camera_info_;  ///< the camera the tracker currently uses
   cv::Mat debug_map_x_, debug_map_y_;    ///< undistortion of the debug image (raw input)
   ros::Time last_stamp_;
+  /// Logs a skipped frame's reason: at once when the reason changes, else at most every 5 s
+  /// (a throttle per call site would hide a new kind of bad input behind the previous one).
+  void warn_skipped(const std::string& reason);
+  std::string last_skip_reason_;
+  ros::WallTime last_skip_log_;
   std::string camera_frame_;  ///< frame_id of the last image
   std::optional<geometry_msgs::PoseStamped> pending_pose_;  ///< applied on the next image
   std::optional<kct::Pose> restart_pose_;  ///< re-applied on a backward time jump
