@@ -1,5 +1,7 @@
 #include "klt_contour_tracker/core/keypoint_tracker.h"
 
+#include "klt_contour_tracker/core/search_area.h"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -34,6 +36,17 @@ void pose_to_rvec_tvec(const Pose& pose, cv::Mat& rvec, cv::Mat& tvec) {
 }
 
 }  // namespace
+
+bool refined_pose_agrees_with_keypoints(const KeypointResult& keypoints, const Pose& refined,
+                                        const PinholeCamera& camera, double max_increase_px) {
+  const KeypointInliers& inliers = keypoints.inlier_points;
+  if (!keypoints.success || inliers.points_object.empty()) return true;
+  // The search area's constraint (Sec. 3.4) with a tighter bound: <= 0 when the mean
+  // reprojection error grew by at most max_increase_px.
+  const ReprojectionConstraint agreement(inliers.points_object, inliers.points_image, camera,
+                                         keypoints.object_to_camera, max_increase_px);
+  return agreement(refined) <= 0.0;
+}
 
 KeypointTracker::KeypointTracker(std::shared_ptr<const Mesh> mesh, const TrackerParams& params)
     : mesh_(mesh), renderer_(mesh), params_(params) {}

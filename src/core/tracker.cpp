@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include "klt_contour_tracker/core/pose_refiner.h"
-#include "klt_contour_tracker/core/search_area.h"
 
 namespace kct {
 
@@ -80,18 +79,6 @@ cv::Mat Tracker::to_gray(const cv::Mat& image) const {
     return undistorted;
   }
   return gray;
-}
-
-bool Tracker::keypoints_agree_with(const TrackResult& result) const {
-  if (!result.refined || !result.keypoints.success) return true;
-  const KeypointInliers& inliers = result.keypoints.inlier_points;
-  if (inliers.points_object.empty()) return true;
-  // The search area's constraint (Sec. 3.4) with a tighter bound: <= 0 when the mean
-  // reprojection error grew by at most redetect_max_reprojection_increase_px.
-  const ReprojectionConstraint agreement(inliers.points_object, inliers.points_image, camera_,
-                                         result.keypoints.object_to_camera,
-                                         params_.redetect_max_reprojection_increase_px);
-  return agreement(result.object_to_camera) <= 0.0;
 }
 
 const ContourExtractor* Tracker::contour_extractor() const {
@@ -218,7 +205,10 @@ TrackResult Tracker::track(const Frame& frame) {
   const bool interval_due = params_.redetect_interval_frames > 0 &&
                             frames_since_detection_ >= params_.redetect_interval_frames;
   if (!result.keypoints.success ||
-      ((keypoints_.needs_redetection() || interval_due) && keypoints_agree_with(result))) {
+      ((keypoints_.needs_redetection() || interval_due) &&
+       (!result.refined ||
+        refined_pose_agrees_with_keypoints(result.keypoints, result.object_to_camera, camera_,
+                                           params_.redetect_max_reprojection_increase_px)))) {
     keypoints_.detect(gray, pose_i1_, camera_);
     frames_since_detection_ = 0;
   }

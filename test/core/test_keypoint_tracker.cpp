@@ -88,5 +88,27 @@ TEST_F(KeypointTrackerTest, NoKeypointsWhenTheObjectIsOutOfView) {
   EXPECT_FALSE(tracker.track(gray_at(test::make_pose(0.4), 2), behind, camera_).success);
 }
 
+TEST(RefinedPoseAgreement, AcceptsPosesTheKeypointsAgreeWithAndRejectsOthers) {
+  const PinholeCamera camera = test::make_camera();
+  const Pose pnp = test::make_pose(0.45);
+  KeypointResult keypoints;
+  keypoints.success = true;
+  keypoints.object_to_camera = pnp;
+  const Mesh box = test::make_box(0.12, 0.08, 0.06);
+  for (const Eigen::Vector3d& v : box.vertices) {
+    keypoints.inlier_points.points_object.push_back(v);
+    keypoints.inlier_points.points_image.push_back(camera.project(pnp * v));
+  }
+  // 0.05 deg moves the box's corners by well under 0.5 px; 3 deg by several px.
+  EXPECT_TRUE(refined_pose_agrees_with_keypoints(keypoints, test::move(pnp, 0.05, {0, 1, 0}, {0, 0, 0}),
+                                                 camera, 0.5));
+  EXPECT_FALSE(refined_pose_agrees_with_keypoints(keypoints, test::move(pnp, 3.0, {0, 1, 0}, {0, 0, 0}),
+                                                  camera, 0.5));
+  // Without KLT there is nothing to disagree with.
+  keypoints.success = false;
+  EXPECT_TRUE(refined_pose_agrees_with_keypoints(keypoints, test::move(pnp, 3.0, {0, 1, 0}, {0, 0, 0}),
+                                                 camera, 0.5));
+}
+
 }  // namespace
 }  // namespace kct

@@ -34,6 +34,13 @@ struct KeypointResult {
   KeypointInliers inlier_points;      ///< correspondences used by the search area
 };
 
+/// True when `refined` keeps the KLT inliers' mean reprojection error within
+/// `max_increase_px` of the PnP pose's (or when KLT failed: nothing to compare). The tracker
+/// re-anchors keypoints only on such poses, so that a refinement that landed in a wrong
+/// optimum stays a one-frame error instead of being baked into the new anchors.
+bool refined_pose_agrees_with_keypoints(const KeypointResult& keypoints, const Pose& refined,
+                                        const PinholeCamera& camera, double max_increase_px);
+
 /// Owns the anchored keypoints between frames.
 class KeypointTracker {
  public:

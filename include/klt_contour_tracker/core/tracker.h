@@ -98,10 +98,6 @@ class Tracker {
   cv::Mat to_gray(const cv::Mat& image) const;
   /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
   std::string check_frame(const Frame& frame) const;
-  /// True unless the refined pose moved the KLT inliers' mean reprojection error up by more
-  /// than redetect_max_reprojection_increase_px over the PnP pose (then keypoints are not
-  /// re-anchored on it).
-  bool keypoints_agree_with(const TrackResult& result) const;
 
   std::shared_ptr<const Mesh> mesh_;
   PinholeCamera camera_;
