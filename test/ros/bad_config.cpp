@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "ros_test_main.h"
+
 namespace {
 
 const std::string kMesh = std::string("file://") + KCT_SOURCE_DIR "/models/demo_crate.obj";
@@ -126,13 +128,4 @@ TEST(BadConfig, ReportedWithoutSubscriptionAndManagerKeepsRunning) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "bad_config_test");
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
-}
+KCT_ROSTEST_MAIN("bad_config_test")

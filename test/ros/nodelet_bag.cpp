@@ -21,6 +21,8 @@
 #include "klt_contour_tracker/TrackerStatus.h"
 #include "klt_contour_tracker/core/pose.h"
 
+#include "ros_test_main.h"
+
 namespace {
 
 // Accuracy required on every frame of the synthetic sequence (ground truth is exact): 10 mm and
@@ -208,13 +210,4 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "nodelet_bag_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
-}
+KCT_ROSTEST_MAIN("nodelet_bag_test")

@@ -22,6 +22,8 @@
 #include "klt_contour_tracker/Init.h"
 #include "klt_contour_tracker/TrackerStatus.h"
 
+#include "ros_test_main.h"
+
 namespace {
 
 const std::string kNode = "/klt_contour_tracker";
@@ -125,13 +127,4 @@ TEST(SimTime, EveryOutputIsStampedWithItsImageStamp) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "sim_time_stamps_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
-}
+KCT_ROSTEST_MAIN("sim_time_stamps_test")

@@ -15,6 +15,8 @@
 #include "klt_contour_tracker/Init.h"
 #include "tracker_harness.h"
 
+#include "ros_test_main.h"
+
 namespace kct_test {
 namespace {
 
@@ -395,13 +397,4 @@ TEST(TrackerInterface, DiagnosticsReportTheStateAndThePoseTopic) {
 }  // namespace
 }  // namespace kct_test
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "tracker_interface_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
-}
+KCT_ROSTEST_MAIN("tracker_interface_test")

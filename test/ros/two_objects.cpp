@@ -8,6 +8,8 @@
 #include "klt_contour_tracker/Init.h"
 #include "tracker_harness.h"
 
+#include "ros_test_main.h"
+
 namespace kct_test {
 namespace {
 
@@ -89,13 +91,4 @@ TEST(TwoObjects, EachTrackerFollowsItsOwnObject) {
 }  // namespace
 }  // namespace kct_test
 
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "two_objects_test");
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  ros::shutdown();
-  return result;
-}
+KCT_ROSTEST_MAIN("two_objects_test")
