@@ -50,6 +50,25 @@ inline Mesh make_box(double sx, double sy, double sz, bool textured = true, int 
   return mesh;
 }
 
+/// Appends the axis-aligned box [lo, hi]: 8 vertices, 12 triangles wound counter-clockwise
+/// from outside (quad order -z, +z, -y, +y, -x, +x; two triangles each), 18 shared edges.
+inline void append_box(Mesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const int base = static_cast<int>(mesh.vertices.size());
+  for (int i = 0; i < 8; ++i)
+    mesh.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
+                               i & 4 ? hi.z() : lo.z());
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const Eigen::Vector3d center = 0.5 * (lo + hi);
+  for (const auto& q : quads)
+    for (const auto& tri : {Eigen::Vector3i(q[0], q[1], q[2]), Eigen::Vector3i(q[0], q[2], q[3])}) {
+      Eigen::Vector3i f = tri.array() + base;
+      const auto &a = mesh.vertices[f[0]], &b = mesh.vertices[f[1]], &c = mesh.vertices[f[2]];
+      if ((b - a).cross(c - a).dot(a - center) < 0.0) std::swap(f[1], f[2]);
+      mesh.faces.push_back(f);
+    }
+}
+
 /// Smooth random colour background (seeded): uniform noise on a grid of `cell_px` cells with
 /// values in [low, high), upsampled bicubically. Small cells and a wide range make clutter.
 inline cv::Mat make_background(const cv::Size& size, int seed, int cell_px = 16, int low = 40,

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "klt_contour_tracker/core/contour_extractor.h"
+#include "synthetic_scene.h"
 
 namespace kct {
 namespace {
@@ -14,20 +15,7 @@ void add_outward(Mesh& mesh, int a, int b, int c, const Eigen::Vector3d& inside)
   mesh.faces.emplace_back(a, b, c);
 }
 
-/// Axis-aligned box [lo, hi]: 8 vertices, 12 triangles, 18 shared edges (6 quad diagonals).
-void append_box(Mesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-  const int base = static_cast<int>(mesh.vertices.size());
-  for (int i = 0; i < 8; ++i)
-    mesh.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
-                               i & 4 ? hi.z() : lo.z());
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  const Eigen::Vector3d center = 0.5 * (lo + hi);
-  for (const auto& q : quads) {
-    add_outward(mesh, base + q[0], base + q[1], base + q[2], center);
-    add_outward(mesh, base + q[0], base + q[2], base + q[3], center);
-  }
-}
+using test::append_box;
 
 std::shared_ptr<const Mesh> make_cube(double half_size_m) {
   auto mesh = std::make_shared<Mesh>();
