@@ -211,6 +211,9 @@ def main():
     args = ap.parse_args()
     presets = args.presets or ["paper", "klt_only"]
     repo = args.repo
+    # Taken now, before anything runs: the code the binaries were built from, not whatever
+    # HEAD is when the run ends (commits may land during a long run).
+    os.environ.setdefault("KCT_BENCH_CODE", code_version(repo))
     data = os.path.join(os.environ.get("KCT_DATA", os.path.join(repo, "data")), "benchmark")
     results = os.path.join(data, "results")
     docs = os.path.join(repo, "docs")
