@@ -21,6 +21,7 @@
 #include "klt_contour_tracker/TrackerStatus.h"
 #include "klt_contour_tracker/core/pose.h"
 
+#include "klt_contour_tracker/ros/ros_conversions.h"
 #include "ros_test_main.h"
 
 namespace {
@@ -40,10 +41,7 @@ struct BagFrame {
   geometry_msgs::PoseStamped::ConstPtr ground_truth;
 };
 
-kct::Pose to_pose(const geometry_msgs::Pose& p) {
-  return kct::pose_from_quaternion(p.position.x, p.position.y, p.position.z, p.orientation.x,
-                                   p.orientation.y, p.orientation.z, p.orientation.w);
-}
+using klt_contour_tracker::from_pose_msg;
 
 std::vector<BagFrame> read_bag(const std::string& path) {
   std::map<ros::Time, BagFrame> by_stamp;
@@ -174,8 +172,8 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
     EXPECT_EQ(poses[i]->header.frame_id, image_header.frame_id) << "frame " << i;
     EXPECT_EQ(statuses[i]->header.stamp, image_header.stamp) << "frame " << i;
     EXPECT_NE(statuses[i]->state, "invalid_input") << statuses[i]->message;
-    const kct::Pose estimate = to_pose(poses[i]->pose);
-    const kct::Pose truth = to_pose(frames[i].ground_truth->pose);
+    const kct::Pose estimate = from_pose_msg(poses[i]->pose);
+    const kct::Pose truth = from_pose_msg(frames[i].ground_truth->pose);
     const double t_mm = 1000.0 * kct::translation_error(estimate, truth);
     const double r_deg = kct::rotation_error_deg(estimate, truth);
     EXPECT_LT(t_mm, kMaxTranslationErrorMm) << "frame " << i;
@@ -203,9 +201,9 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
   ASSERT_TRUE(play(frames.front()));
   const auto after_loop = recorder.poses();
   ASSERT_EQ(after_loop.size(), frames.size() + 1);
-  const kct::Pose reinitialized = to_pose(after_loop.back()->pose);
-  EXPECT_LT(1000.0 * kct::translation_error(reinitialized, to_pose(first)), 1e-3);
-  EXPECT_LT(kct::rotation_error_deg(reinitialized, to_pose(first)), 1e-3);
+  const kct::Pose reinitialized = from_pose_msg(after_loop.back()->pose);
+  EXPECT_LT(1000.0 * kct::translation_error(reinitialized, from_pose_msg(first)), 1e-3);
+  EXPECT_LT(kct::rotation_error_deg(reinitialized, from_pose_msg(first)), 1e-3);
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/pose.h"
 #include "klt_contour_tracker/core/renderer.h"
+#include "klt_contour_tracker/ros/ros_conversions.h"
 
 namespace kct_test {
 
@@ -45,23 +46,9 @@ inline ros::Time next_stamp() {
   return ros::Time(t);
 }
 
-inline kct::Pose to_pose(const geometry_msgs::Pose& p) {
-  return kct::pose_from_quaternion(p.position.x, p.position.y, p.position.z, p.orientation.x,
-                                   p.orientation.y, p.orientation.z, p.orientation.w);
-}
-
-inline geometry_msgs::Pose to_msg(const kct::Pose& pose) {
-  geometry_msgs::Pose m;
-  const Eigen::Quaterniond q(pose.rotation());
-  m.position.x = pose.translation().x();
-  m.position.y = pose.translation().y();
-  m.position.z = pose.translation().z();
-  m.orientation.x = q.x();
-  m.orientation.y = q.y();
-  m.orientation.z = q.z();
-  m.orientation.w = q.w();
-  return m;
-}
+// Pose <-> message: the package's own conversions (ros_conversions.h).
+using klt_contour_tracker::from_pose_msg;
+using klt_contour_tracker::to_pose_msg;
 
 /// The demo crate (or several objects) rendered over a background with a 640x480 camera.
 struct Scene {
@@ -213,7 +200,7 @@ inline XmlRpc::XmlRpcValue list(const std::vector<double>& values) {
 
 /// ~initial_pose/position and /orientation parameters for `pose`.
 inline void set_initial_pose(std::map<std::string, XmlRpc::XmlRpcValue>& params, const kct::Pose& pose) {
-  const geometry_msgs::Pose m = to_msg(pose);
+  const geometry_msgs::Pose m = to_pose_msg(pose);
   params["initial_pose/position"] = list({m.position.x, m.position.y, m.position.z});
   params["initial_pose/orientation"] =
       list({m.orientation.x, m.orientation.y, m.orientation.z, m.orientation.w});

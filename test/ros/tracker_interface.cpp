@@ -57,7 +57,7 @@ bool call_init(const std::string& name, const geometry_msgs::PoseStamped& pose,
 geometry_msgs::PoseStamped stamped(const kct::Pose& pose, const std::string& frame = "") {
   geometry_msgs::PoseStamped m;
   m.header.frame_id = frame;
-  m.pose = to_msg(pose);
+  m.pose = to_pose_msg(pose);
   return m;
 }
 
@@ -71,7 +71,7 @@ void expect_recovers_on_the_next_good_frame() {
   const auto pose = shared().harness.last_pose();
   ASSERT_TRUE(pose);
   EXPECT_EQ(pose->header.stamp, status->header.stamp);
-  EXPECT_LT(kct::translation_error(to_pose(pose->pose), shared().truth), 0.005);
+  EXPECT_LT(kct::translation_error(from_pose_msg(pose->pose), shared().truth), 0.005);
 }
 
 TEST(TrackerInterface, WaitsForAPoseThenTheInitServiceStartsTracking) {
@@ -93,14 +93,14 @@ TEST(TrackerInterface, WaitsForAPoseThenTheInitServiceStartsTracking) {
   EXPECT_EQ(first->state, "initialized");
   EXPECT_EQ(first->tracking_state, "tracking");
   ASSERT_TRUE(first->pose_published);
-  EXPECT_LT(kct::translation_error(to_pose(s.harness.last_pose()->pose), s.truth), 1e-6);
+  EXPECT_LT(kct::translation_error(from_pose_msg(s.harness.last_pose()->pose), s.truth), 1e-6);
   for (int i = 0; i < 5; ++i) {
     const auto status = s.step();
     ASSERT_TRUE(status);
     EXPECT_EQ(status->state, "keypoints") << i;
     EXPECT_GT(status->quality, 0.5) << i;
-    EXPECT_LT(kct::translation_error(to_pose(s.harness.last_pose()->pose), s.truth), 0.005) << i;
-    EXPECT_LT(kct::rotation_error_deg(to_pose(s.harness.last_pose()->pose), s.truth), 2.0) << i;
+    EXPECT_LT(kct::translation_error(from_pose_msg(s.harness.last_pose()->pose), s.truth), 0.005) << i;
+    EXPECT_LT(kct::rotation_error_deg(from_pose_msg(s.harness.last_pose()->pose), s.truth), 2.0) << i;
   }
   // ~pose_with_covariance: same stamp and pose, a positive-definite covariance with depth the
   // least certain translation (a small object seen from 0.45 m).
@@ -152,7 +152,7 @@ TEST(TrackerInterface, InitialPoseInAWorldFrameIsTransformedThroughTf) {
   geometry_msgs::TransformStamped t;
   t.header.frame_id = "world";
   t.child_frame_id = kCameraFrame;
-  const geometry_msgs::Pose p = to_msg(world_to_camera_optical);
+  const geometry_msgs::Pose p = to_pose_msg(world_to_camera_optical);
   t.transform.translation.x = p.position.x;
   t.transform.translation.y = p.position.y;
   t.transform.translation.z = p.position.z;
@@ -172,8 +172,8 @@ TEST(TrackerInterface, InitialPoseInAWorldFrameIsTransformedThroughTf) {
   const auto pose = s.harness.last_pose();
   ASSERT_TRUE(pose);
   EXPECT_EQ(pose->header.frame_id, kCameraFrame);
-  EXPECT_LT(kct::translation_error(to_pose(pose->pose), s.truth), 1e-6);
-  EXPECT_LT(kct::rotation_error_deg(to_pose(pose->pose), s.truth), 1e-4);
+  EXPECT_LT(kct::translation_error(from_pose_msg(pose->pose), s.truth), 1e-6);
+  EXPECT_LT(kct::rotation_error_deg(from_pose_msg(pose->pose), s.truth), 1e-4);
   // And the published tf chains back into the world frame.
   ASSERT_TRUE(wait_for([&] { return buffer.canTransform("world", "crate", status->header.stamp); }, 5.0));
   const auto world_to_object = buffer.lookupTransform("world", "crate", status->header.stamp);
@@ -290,7 +290,7 @@ TEST(TrackerInterface, LostWhileHiddenAndReacquiredWhenTheObjectComesBack) {
     EXPECT_EQ(status->tracking_state, "tracking") << "frame " << i;
     EXPECT_TRUE(status->good) << "frame " << i << " quality " << status->quality;
   }
-  EXPECT_LT(kct::translation_error(to_pose(harness.last_pose()->pose), truth), 0.005);
+  EXPECT_LT(kct::translation_error(from_pose_msg(harness.last_pose()->pose), truth), 0.005);
   const size_t poses_before_hiding = harness.poses().size();
 
   int lost_at = -1;
@@ -320,7 +320,7 @@ TEST(TrackerInterface, LostWhileHiddenAndReacquiredWhenTheObjectComesBack) {
   EXPECT_LE(tracking_again_at, 4);
   ASSERT_EQ(statuses.back()->tracking_state, "tracking");
   EXPECT_TRUE(statuses.back()->pose_published);
-  const kct::Pose final_pose = to_pose(harness.last_pose()->pose);
+  const kct::Pose final_pose = from_pose_msg(harness.last_pose()->pose);
   EXPECT_EQ(harness.last_pose()->header.stamp, statuses.back()->header.stamp);
   // Tolerance: 5 mm and 3 deg after re-acquisition (coarse visibility table).
   EXPECT_LT(kct::translation_error(final_pose, truth), 0.005);

@@ -49,7 +49,7 @@ TEST(TwoObjects, EachTrackerFollowsItsOwnObject) {
   for (const auto& [name, pose] : {std::make_pair(std::string("/tracker_a"), truth_a),
                                    std::make_pair(std::string("/tracker_b"), truth_b)}) {
     klt_contour_tracker::Init srv;
-    srv.request.pose.pose = to_msg(pose);
+    srv.request.pose.pose = to_pose_msg(pose);
     ASSERT_TRUE(ros::service::call(name + "/init", srv));
     ASSERT_TRUE(srv.response.accepted) << srv.response.message;
   }
@@ -71,10 +71,10 @@ TEST(TwoObjects, EachTrackerFollowsItsOwnObject) {
     EXPECT_EQ(a->header.stamp, stamp);
     EXPECT_EQ(b->header.stamp, stamp);
     // Tolerance: 5 mm and 2 deg (keypoints of a 12 cm crate at 0.5 m, 12 frames).
-    EXPECT_LT(kct::translation_error(to_pose(a->pose), truth_a), 0.005) << "frame " << i;
-    EXPECT_LT(kct::rotation_error_deg(to_pose(a->pose), truth_a), 2.0) << "frame " << i;
-    EXPECT_LT(kct::translation_error(to_pose(b->pose), truth_b), 0.005) << "frame " << i;
-    EXPECT_LT(kct::rotation_error_deg(to_pose(b->pose), truth_b), 2.0) << "frame " << i;
+    EXPECT_LT(kct::translation_error(from_pose_msg(a->pose), truth_a), 0.005) << "frame " << i;
+    EXPECT_LT(kct::rotation_error_deg(from_pose_msg(a->pose), truth_a), 2.0) << "frame " << i;
+    EXPECT_LT(kct::translation_error(from_pose_msg(b->pose), truth_b), 0.005) << "frame " << i;
+    EXPECT_LT(kct::rotation_error_deg(from_pose_msg(b->pose), truth_b), 2.0) << "frame " << i;
   }
   // Each has its own tf child frame under the camera frame.
   const ros::Time last = recorder_a.poses().back()->header.stamp;
