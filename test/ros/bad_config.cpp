@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "ros_test_main.h"
+#include "ros_test_util.h"
 
 namespace {
 
@@ -42,15 +42,6 @@ std::set<std::string> subscribed_topics() {
   for (int i = 0; i < subscribers.size(); ++i)
     topics.insert(static_cast<std::string>(subscribers[i][0]));
   return topics;
-}
-
-bool wait_for(const std::function<bool()>& condition, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (condition()) return true;
-    ros::WallDuration(0.05).sleep();
-  }
-  return condition();
 }
 
 /// Sets the valid parameters of nodelet `name`, lets `spoil` break one, loads it into /manager

@@ -22,7 +22,7 @@
 #include "klt_contour_tracker/core/pose.h"
 
 #include "klt_contour_tracker/ros/ros_conversions.h"
-#include "ros_test_main.h"
+#include "ros_test_util.h"
 
 namespace {
 
@@ -89,15 +89,6 @@ class Recorder {
   std::vector<klt_contour_tracker::TrackerStatus::ConstPtr> statuses_;
 };
 
-bool wait_for(const std::function<bool()>& condition, ros::WallDuration timeout) {
-  const ros::WallTime end = ros::WallTime::now() + timeout;
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (condition()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return condition();
-}
-
 TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
@@ -146,7 +137,7 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
         return image_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0 &&
                pose_sub.getNumPublishers() > 0 && status_sub.getNumPublishers() > 0;
       },
-      ros::WallDuration(30.0)))
+      30.0))
       << "the nodelet did not connect";
 
   // One frame at a time: publish, wait for its status (published for every processed frame).
@@ -154,7 +145,7 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
     const size_t before = recorder.status_count();
     info_pub.publish(frame.info);
     image_pub.publish(frame.image);
-    return wait_for([&] { return recorder.status_count() > before; }, kFrameTimeout);
+    return wait_for([&] { return recorder.status_count() > before; }, kFrameTimeout.toSec());
   };
   for (size_t i = 0; i < frames.size(); ++i) {
     ASSERT_TRUE(play(frames[i])) << "no status for frame " << i << " within "
@@ -189,7 +180,7 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
   geometry_msgs::TransformStamped tf_msg;
   ASSERT_TRUE(wait_for(
       [&] { return tf_buffer.canTransform(last_header.frame_id, "object", last_header.stamp); },
-      ros::WallDuration(5.0)));
+      5.0));
   tf_msg = tf_buffer.lookupTransform(last_header.frame_id, "object", last_header.stamp);
   const geometry_msgs::Pose& last_pose = poses.back()->pose;
   EXPECT_NEAR(tf_msg.transform.translation.x, last_pose.position.x, 1e-9);

@@ -22,20 +22,11 @@
 #include "klt_contour_tracker/Init.h"
 #include "klt_contour_tracker/TrackerStatus.h"
 
-#include "ros_test_main.h"
+#include "ros_test_util.h"
 
 namespace {
 
 const std::string kNode = "/klt_contour_tracker";
-
-bool wait_for(const std::function<bool()>& condition, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (condition()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return condition();
-}
 
 /// Stamps of every output message, by output.
 class Stamps {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "../core/synthetic_scene.h"
+#include "ros_test_util.h"
 #include "klt_contour_tracker/TrackerStatus.h"
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/pose.h"
@@ -29,15 +30,6 @@ namespace kct_test {
 
 const std::string kCameraFrame = "camera_optical";
 const std::string kMeshPath = KCT_SOURCE_DIR "/models/demo_crate.obj";
-
-inline bool wait_for(const std::function<bool()>& condition, double timeout_s) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    if (condition()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return condition();
-}
 
 /// Stamps that only go forward across all tests of a process (a backward jump re-initializes).
 inline ros::Time next_stamp() {

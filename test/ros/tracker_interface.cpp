@@ -15,7 +15,7 @@
 #include "klt_contour_tracker/Init.h"
 #include "tracker_harness.h"
 
-#include "ros_test_main.h"
+#include "ros_test_util.h"
 
 namespace kct_test {
 namespace {
