@@ -1,0 +1,261 @@
+#include "klt_contour_tracker/core/contour_cost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace kct {
+namespace {
+
+constexpr double kMinDepth = 1e-6;  // metres, as the extractor
+constexpr double kContrastFactor = 8.0;
+
+/// Bilinear interpolation of a CV_32F image at (x0 + fx, y0 + fy); 0 <= x0 < cols - 1 and
+/// 0 <= y0 < rows - 1 guaranteed by the caller.
+inline double bilinear(const cv::Mat& image, int x0, int y0, double fx, double fy) {
+  const float* r0 = image.ptr<float>(y0) + x0;
+  const float* r1 = image.ptr<float>(y0 + 1) + x0;
+  const double top = r0[0] + fx * (r0[1] - r0[0]);
+  const double bottom = r1[0] + fx * (r1[1] - r1[0]);
+  return top + fy * (bottom - top);
+}
+
+/// d/dx and d/dy of bilinear() at the same point (exact, constant inside a pixel cell).
+inline Eigen::Vector2d bilinear_derivative(const cv::Mat& image, int x0, int y0, double fx,
+                                           double fy) {
+  const float* r0 = image.ptr<float>(y0) + x0;
+  const float* r1 = image.ptr<float>(y0 + 1) + x0;
+  return {(1.0 - fy) * (r0[1] - r0[0]) + fy * (r1[1] - r1[0]),
+          (1.0 - fx) * (r1[0] - r0[0]) + fx * (r1[1] - r0[1])};
+}
+
+/// Runs fn(i) for i < n on up to `threads` threads (the caller's included). Each i must write
+/// only its own outputs, so the result does not depend on the thread count.
+template <typename Fn>
+void run_parallel(int n, int threads, Fn&& fn) {
+  threads = std::max(1, std::min(threads, n));
+  if (threads == 1) {
+    for (int i = 0; i < n; ++i) fn(i);
+    return;
+  }
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t)
+    pool.emplace_back([&, t]() {
+      for (int i = t; i < n; i += threads) fn(i);
+    });
+  for (int i = 0; i < n; i += threads) fn(i);
+  for (auto& thread : pool) thread.join();
+}
+
+}  // namespace
+
+ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, double spacing_px,
+                         double blur_sigma_px, int num_threads)
+    : extractor_(std::move(extractor)),
+      spacing_px_(spacing_px),
+      blur_sigma_px_(blur_sigma_px),
+      edge_width_px_(std::sqrt(blur_sigma_px * blur_sigma_px + 1.0)),
+      num_threads_(num_threads) {
+  if (!extractor_) throw std::invalid_argument("ContourCost: extractor is null");
+  if (!(spacing_px > 0.0) || !std::isfinite(spacing_px))
+    throw std::invalid_argument("ContourCost: spacing_px must be > 0, got " +
+                                std::to_string(spacing_px));
+  if (!(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0))
+    throw std::invalid_argument("ContourCost: blur_sigma_px must be in [0, 20], got " +
+                                std::to_string(blur_sigma_px));
+  if (num_threads < 1)
+    throw std::invalid_argument("ContourCost: num_threads must be >= 1, got " +
+                                std::to_string(num_threads));
+}
+
+void ContourCost::begin_frame(const PoseCostFrame& frame) {
+  if (frame.levels.empty()) throw std::invalid_argument("ContourCost: frame has no levels");
+  frame_ = &frame;
+  segments_.clear();
+  samples_.clear();
+  level_ = 0;
+
+  // Region around the object's projection at the preliminary pose (full-resolution px): the
+  // bounding sphere of the mesh, plus its projected radius and 32 px on every side.
+  const Mesh& mesh = extractor_->mesh();
+  const Eigen::Vector3d center_object = mesh.bounding_box_center();
+  double radius = 0.0;
+  for (const auto& v : mesh.vertices) radius = std::max(radius, (v - center_object).norm());
+  const PinholeCamera& camera = frame.levels[0].camera;
+  const Eigen::Vector3d center = frame.predicted_object_to_camera * center_object;
+  cv::Rect2d full(0, 0, camera.width(), camera.height());
+  if (center.z() > radius + kMinDepth) {
+    const Eigen::Vector2d c = camera.project(center);
+    const double r = std::max(camera.fx(), camera.fy()) * radius / (center.z() - radius);
+    const double half = 2.0 * r + 32.0;
+    full = cv::Rect2d(c.x() - half, c.y() - half, 2 * half, 2 * half) &
+           cv::Rect2d(0, 0, camera.width(), camera.height());
+  }
+
+  levels_.assign(frame.levels.size(), LevelImages());
+  run_parallel(static_cast<int>(frame.levels.size()), num_threads_, [&](int l) {
+    const PyramidLevel& level = frame.levels[l];
+    LevelImages& out = levels_[l];
+    const cv::Rect bounds(0, 0, level.gray.cols, level.gray.rows);
+    cv::Rect roi(static_cast<int>(std::floor(full.x * level.scale)),
+                 static_cast<int>(std::floor(full.y * level.scale)),
+                 static_cast<int>(std::ceil(full.width * level.scale)) + 2,
+                 static_cast<int>(std::ceil(full.height * level.scale)) + 2);
+    roi &= bounds;
+    out.roi = roi;
+    if (roi.width < 3 || roi.height < 3) {
+      out.roi = cv::Rect();
+      return;
+    }
+    // Blur on a slightly larger window so that the region's border is not biased by padding.
+    const int pad = static_cast<int>(std::ceil(3.0 * blur_sigma_px_)) + 2;
+    const cv::Rect outer = cv::Rect(roi.x - pad, roi.y - pad, roi.width + 2 * pad,
+                                    roi.height + 2 * pad) & bounds;
+    cv::Mat image;
+    level.gray(outer).convertTo(image, CV_32F);
+    if (blur_sigma_px_ > 0.0)
+      cv::GaussianBlur(image, image, cv::Size(), blur_sigma_px_, blur_sigma_px_,
+                       cv::BORDER_REPLICATE);
+    cv::Mat gx, gy;
+    // Sobel 3x3 / 8: a ramp of slope s gives s (as GradientImage::compute).
+    cv::Sobel(image, gx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+    cv::Sobel(image, gy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+    const cv::Rect inner(roi.x - outer.x, roi.y - outer.y, roi.width, roi.height);
+    out.gx = gx(inner);
+    out.gy = gy(inner);
+    cv::Mat magnitude;
+    cv::magnitude(out.gx, out.gy, magnitude);
+    out.contrast = std::max(1e-3, kContrastFactor * cv::mean(magnitude)[0]);
+  });
+}
+
+double ContourCost::contrast_scale() const {
+  return levels_.empty() ? 1.0 : levels_[level_].contrast;
+}
+
+void ContourCost::linearize(const Pose& object_to_camera, int level) {
+  if (!frame_ || level < 0 || level >= static_cast<int>(levels_.size()))
+    throw std::invalid_argument("ContourCost::linearize: begin_frame() first, level " +
+                                std::to_string(level) + " out of range");
+  level_ = level;
+  segments_.clear();
+  samples_.clear();
+  if (levels_[level].roi.empty()) return;
+  const PinholeCamera& camera = frame_->levels[level].camera;
+  extractor_->extract(object_to_camera, camera, scratch_);
+  const std::vector<MeshEdge>& edges = extractor_->edges();
+  const std::vector<Eigen::Vector3d>& vertices = extractor_->mesh().vertices;
+  for (const ContourSegment& s : scratch_) {
+    const double length = (s.b_px - s.a_px).norm();
+    if (!(length > 1e-9) || !std::isfinite(length)) continue;
+    const int n = std::max(1, static_cast<int>(std::lround(length / spacing_px_)));
+    Segment segment;
+    segment.a_object = vertices[edges[s.edge].v0];
+    segment.b_object = vertices[edges[s.edge].v1];
+    segment.first_sample = static_cast<int>(samples_.size());
+    for (int k = 0; k < n; ++k)
+      samples_.push_back(segment.a_object + ((k + 0.5) / n) * (segment.b_object - segment.a_object));
+    segment.end_sample = static_cast<int>(samples_.size());
+    segments_.push_back(segment);
+  }
+}
+
+double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6d* gradient,
+                               Matrix6d* hessian) const {
+  const LevelImages& images = levels_[level_];
+  const PinholeCamera& camera = frame_->levels[level_].camera;
+  const double fx = camera.fx(), fy = camera.fy(), cx = camera.cx(), cy = camera.cy();
+  const double x_lo = images.roi.x + 1.0, y_lo = images.roi.y + 1.0;
+  const double x_hi = images.roi.x + images.roi.width - 2.0;
+  const double y_hi = images.roi.y + images.roi.height - 2.0;
+  const bool derivatives = gradient || hessian;
+  const Eigen::Matrix3d r = object_to_camera.linear();
+  const Eigen::Vector3d t = object_to_camera.translation();
+  const Eigen::Vector3d center_camera = object_to_camera * frame_->center_object;
+  const double inv_sigma2 = 1.0 / (edge_width_px_ * edge_width_px_);
+  Eigen::Matrix2d perp;
+  perp << 0.0, -1.0, 1.0, 0.0;
+
+  double sum = 0.0;
+  int kept = 0;
+  for (const Segment& segment : segments_) {
+    const Eigen::Vector3d a = r * segment.a_object + t, b = r * segment.b_object + t;
+    if (a.z() <= kMinDepth || b.z() <= kMinDepth) continue;
+    const Eigen::Vector2d pa(fx * a.x() / a.z() + cx, fy * a.y() / a.z() + cy);
+    const Eigen::Vector2d pb(fx * b.x() / b.z() + cx, fy * b.y() / b.z() + cy);
+    const Eigen::Vector2d d = pb - pa;
+    const double length = d.norm();
+    if (!(length > 1e-9) || !std::isfinite(length)) continue;
+    const Eigen::Vector2d normal = perp * d / length;
+    Matrix26d normal_jacobian = Matrix26d::Zero();  // d normal / d delta
+    if (derivatives) {
+      const Matrix26d dd = projection_jacobian(b, center_camera, fx, fy) -
+                           projection_jacobian(a, center_camera, fx, fy);
+      normal_jacobian =
+          (Eigen::Matrix2d::Identity() - normal * normal.transpose()) * perp * dd / length;
+    }
+    for (int k = segment.first_sample; k < segment.end_sample; ++k) {
+      const Eigen::Vector3d x = r * samples_[k] + t;
+      if (x.z() <= kMinDepth) continue;
+      const double u = fx * x.x() / x.z() + cx, v = fy * x.y() / x.z() + cy;
+      if (!(u >= x_lo && v >= y_lo && u <= x_hi && v <= y_hi)) continue;
+      const double lu = u - images.roi.x, lv = v - images.roi.y;
+      const int x0 = std::min(static_cast<int>(lu), images.roi.width - 2);
+      const int y0 = std::min(static_cast<int>(lv), images.roi.height - 2);
+      const double ax = lu - x0, ay = lv - y0;
+      const Eigen::Vector2d g(bilinear(images.gx, x0, y0, ax, ay),
+                              bilinear(images.gy, x0, y0, ax, ay));
+      const double along = g.dot(normal);
+      const double value = std::abs(along);
+      sum += value;
+      ++kept;
+      if (!derivatives) continue;
+      // d(g . n)/dp = n^T dg/dp, dg/dp the exact derivative of the bilinear interpolation.
+      const Eigen::Vector2d dgx = bilinear_derivative(images.gx, x0, y0, ax, ay);
+      const Eigen::Vector2d dgy = bilinear_derivative(images.gy, x0, y0, ax, ay);
+      const Eigen::RowVector2d dvalue_dp(normal.x() * dgx.x() + normal.y() * dgy.x(),
+                                         normal.x() * dgx.y() + normal.y() * dgy.y());
+      const Matrix26d jp = projection_jacobian(x, center_camera, fx, fy);
+      const double sign = along >= 0.0 ? 1.0 : -1.0;
+      if (gradient)
+        *gradient += sign * (dvalue_dp * jp + g.transpose() * normal_jacobian).transpose();
+      if (hessian) {
+        const Eigen::Matrix<double, 1, 6> along_normal = normal.transpose() * jp;
+        *hessian += (value * inv_sigma2) * along_normal.transpose() * along_normal;
+      }
+    }
+  }
+  if (count) *count = kept;
+  return sum;
+}
+
+double ContourCost::energy(const Pose& object_to_camera, int* num_points) const {
+  if (!frame_ || levels_.empty() || levels_[level_].roi.empty()) {
+    if (num_points) *num_points = 0;
+    return 0.0;
+  }
+  int count = 0;
+  const double sum = accumulate(object_to_camera, &count, nullptr, nullptr);
+  if (num_points) *num_points = count;
+  return count > 0 ? sum / count : 0.0;
+}
+
+double ContourCost::evaluate(const Pose& object_to_camera, Vector6d* gradient,
+                             Matrix6d* hessian) const {
+  if (!frame_ || levels_.empty() || levels_[level_].roi.empty()) return 0.0;
+  Vector6d g = Vector6d::Zero();
+  Matrix6d h = Matrix6d::Zero();
+  int count = 0;
+  const double sum = accumulate(object_to_camera, &count, gradient ? &g : nullptr,
+                                hessian ? &h : nullptr);
+  if (count == 0) return 0.0;
+  const double scale = 1.0 / (count * levels_[level_].contrast);
+  if (gradient) *gradient -= scale * g;  // cost = -E / c
+  if (hessian) *hessian += scale * h;
+  return -sum * scale;
+}
+
+}  // namespace kct

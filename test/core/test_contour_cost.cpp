@@ -1,0 +1,181 @@
+// The pose-cost interface (pose increments, projection Jacobians, the weighted sum) and the
+// contour cue's analytic gradient, on a rendered box view.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <opencv2/imgproc.hpp>
+
+#include "klt_contour_tracker/core/contour_cost.h"
+#include "klt_contour_tracker/core/visibility_table.h"
+#include "synthetic_scene.h"
+
+namespace kct {
+namespace {
+
+/// Central-difference gradient of `cost` w.r.t. the pose increment around `pose`.
+Vector6d numeric_gradient(const PoseCost& cost, const Pose& pose, const Eigen::Vector3d& center,
+                          double step_rad, double step_m) {
+  Vector6d g;
+  for (int i = 0; i < 6; ++i) {
+    Vector6d d = Vector6d::Zero();
+    d(i) = i < 3 ? step_rad : step_m;
+    const double plus = cost.evaluate(apply_pose_increment(pose, d, center), nullptr, nullptr);
+    const double minus = cost.evaluate(apply_pose_increment(pose, -d, center), nullptr, nullptr);
+    g(i) = (plus - minus) / (2.0 * d(i));
+  }
+  return g;
+}
+
+TEST(PoseIncrement, ZeroIsIdentityAndRotationKeepsTheCentre) {
+  const Pose pose = test::make_pose(0.5);
+  const Eigen::Vector3d center(0.01, 0.02, -0.03);
+  EXPECT_TRUE(apply_pose_increment(pose, Vector6d::Zero(), center).isApprox(pose, 1e-12));
+  Vector6d rotate = Vector6d::Zero();
+  rotate.head<3>() = Eigen::Vector3d(0.1, -0.2, 0.3);
+  const Pose moved = apply_pose_increment(pose, rotate, center);
+  EXPECT_LT((moved * center - pose * center).norm(), 1e-12);
+  EXPECT_NEAR(rotation_error_deg(moved, pose), Eigen::Vector3d(0.1, -0.2, 0.3).norm() * 180 / M_PI,
+              1e-9);
+}
+
+TEST(PoseIncrement, ProjectionJacobianMatchesFiniteDifferences) {
+  const Pose pose = test::make_pose(0.5);
+  const Eigen::Vector3d center(0.01, 0.02, -0.03), point(0.05, -0.04, 0.02);
+  const PinholeCamera camera = test::make_camera();
+  const Matrix26d j = projection_jacobian(pose * point, pose * center, camera.fx(), camera.fy());
+  for (int i = 0; i < 6; ++i) {
+    Vector6d d = Vector6d::Zero();
+    d(i) = 1e-6;
+    const Eigen::Vector2d numeric =
+        (camera.project(apply_pose_increment(pose, d, center) * point) -
+         camera.project(apply_pose_increment(pose, -d, center) * point)) / 2e-6;
+    // Tolerance: 1e-4 relative (central differences, step 1e-6).
+    EXPECT_LT((numeric - j.col(i)).norm(), 1e-4 * std::max(1.0, numeric.norm())) << "column " << i;
+  }
+}
+
+/// A cue with a known quadratic cost, for the sum.
+class QuadraticCue : public PoseCost {
+ public:
+  explicit QuadraticCue(double scale) : scale_(scale) {}
+  std::string name() const override { return "quadratic"; }
+  void begin_frame(const PoseCostFrame&) override { ++frames; }
+  void linearize(const Pose&, int) override { ++linearizations; }
+  double evaluate(const Pose& pose, Vector6d* gradient, Matrix6d* hessian) const override {
+    const double x = pose.translation().x();
+    if (gradient) (*gradient)(3) += 2 * scale_ * x;
+    if (hessian) (*hessian)(3, 3) += 2 * scale_;
+    return scale_ * x * x;
+  }
+  int frames = 0, linearizations = 0;
+
+ private:
+  double scale_;
+};
+
+TEST(PoseCostSum, WeightsEachCueAndSkipsZeroWeights) {
+  auto a = std::make_shared<QuadraticCue>(1.0), b = std::make_shared<QuadraticCue>(10.0);
+  PoseCostSum sum;
+  sum.add(a, 2.0);
+  sum.add(b, 0.0);
+  EXPECT_THROW(sum.add(a, -1.0), std::invalid_argument);
+  EXPECT_THROW(sum.add(nullptr, 1.0), std::invalid_argument);
+  sum.begin_frame(PoseCostFrame());
+  sum.linearize(Pose::Identity(), 0);
+  EXPECT_EQ(a->frames, 1);
+  EXPECT_EQ(b->frames, 0);
+  Pose pose = Pose::Identity();
+  pose.translation().x() = 3.0;
+  Vector6d g;
+  Matrix6d h;
+  EXPECT_DOUBLE_EQ(sum.evaluate(pose, &g, &h), 18.0);
+  EXPECT_DOUBLE_EQ(g(3), 12.0);
+  EXPECT_DOUBLE_EQ(h(3, 3), 4.0);
+}
+
+class ContourCostTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto visibility = VisibilityTable::build(*mesh_, 2, 128, "");
+    extractor_ = std::make_shared<ContourExtractor>(mesh_, visibility, 45.0);
+    cv::Mat gray;
+    cv::cvtColor(test::render_frame(renderer_, camera_, truth_, background_, 2.0, 1), gray,
+                 cv::COLOR_BGR2GRAY);
+    frame_.levels = make_pyramid(gray, camera_, 3);
+    frame_.predicted_object_to_camera = frame_.preliminary_object_to_camera = truth_;
+    frame_.center_object = mesh_->bounding_box_center();
+  }
+
+  std::shared_ptr<const Mesh> mesh_ = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  Renderer renderer_{mesh_};
+  PinholeCamera camera_ = test::make_camera();
+  cv::Mat background_ = test::make_background(camera_.size(), 21, 32, 10, 60);
+  Pose truth_ = test::make_pose(0.45);
+  std::shared_ptr<const ContourExtractor> extractor_;
+  PoseCostFrame frame_;
+};
+
+TEST_F(ContourCostTest, AnalyticGradientMatchesNumericOnEveryLevel) {
+  ContourCost cost(extractor_, 2.0, 1.0);
+  cost.begin_frame(frame_);
+  // Off the optimum (where |g . n| has kinks), contour held fixed at the linearization.
+  const Pose pose = test::move(truth_, 1.0, {0.3, 1.0, -0.2}, {0.0015, -0.001, 0.002});
+  for (int level = 0; level < 3; ++level) {
+    cost.linearize(pose, level);
+    ASSERT_TRUE(cost.active());
+    Vector6d analytic = Vector6d::Zero();
+    Matrix6d hessian = Matrix6d::Zero();
+    cost.evaluate(pose, &analytic, &hessian);
+    // Steps moving the contour by about 0.02 level px: few points cross a pixel cell's border
+    // (where the bilinear interpolation's derivative jumps).
+    const double px_m = 0.45 / (camera_.fx() * std::pow(0.5, level));
+    const Vector6d numeric =
+        numeric_gradient(cost, pose, frame_.center_object, 0.02 * px_m / 0.07, 0.02 * px_m);
+    // Tolerance: 2% of the gradient's norm (the cell-border crossings).
+    EXPECT_LT((analytic - numeric).norm(), 0.02 * numeric.norm())
+        << "level " << level << "\nanalytic " << analytic.transpose() << "\nnumeric "
+        << numeric.transpose();
+    // The Hessian approximation is symmetric positive semi-definite.
+    EXPECT_LT((hessian - hessian.transpose()).norm(), 1e-12 * hessian.norm());
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix6d>(hessian).eigenvalues().minCoeff(),
+              -1e-9 * hessian.norm());
+  }
+}
+
+TEST_F(ContourCostTest, EnergyIsHighestAndCostLowestAtTheTruePose) {
+  ContourCost cost(extractor_, 2.0, 1.0);
+  cost.begin_frame(frame_);
+  cost.linearize(truth_, 0);
+  const Pose off = test::move(truth_, 2.0, {1, 0, 0}, {0.002, 0, 0});
+  EXPECT_GT(cost.energy(truth_), 1.5 * cost.energy(off));
+  EXPECT_LT(cost.evaluate(truth_, nullptr, nullptr), cost.evaluate(off, nullptr, nullptr));
+  // About -1 at the true pose by construction of the contrast scale (within a factor 3).
+  EXPECT_LT(cost.evaluate(truth_, nullptr, nullptr), -1.0 / 3.0);
+  EXPECT_GT(cost.evaluate(truth_, nullptr, nullptr), -3.0);
+}
+
+TEST_F(ContourCostTest, ResultDoesNotDependOnTheThreadCount) {
+  ContourCost one(extractor_, 2.0, 1.0, 1), two(extractor_, 2.0, 1.0, 2);
+  one.begin_frame(frame_);
+  two.begin_frame(frame_);
+  const Pose pose = test::move(truth_, 1.0, {0.3, 1.0, -0.2}, {0.0015, -0.001, 0.002});
+  for (int level = 0; level < 3; ++level) {
+    one.linearize(pose, level);
+    two.linearize(pose, level);
+    Vector6d g1 = Vector6d::Zero(), g2 = Vector6d::Zero();
+    EXPECT_EQ(one.evaluate(pose, &g1, nullptr), two.evaluate(pose, &g2, nullptr));
+    EXPECT_EQ(g1, g2);
+  }
+}
+
+TEST(ContourCost, RejectsBadSettings) {
+  auto mesh = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1, false));
+  auto extractor = std::make_shared<ContourExtractor>(mesh, nullptr, 45.0);
+  EXPECT_THROW(ContourCost(nullptr, 2.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(ContourCost(extractor, 0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(ContourCost(extractor, 2.0, -1.0), std::invalid_argument);
+  EXPECT_THROW(ContourCost(extractor, 2.0, 1.0, 0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace kct
