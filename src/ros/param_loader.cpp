@@ -1,5 +1,7 @@
 #include "klt_contour_tracker/ros/param_loader.h"
 
+#include "klt_contour_tracker/core/model_units.h"
+
 #include <ros/names.h>
 #include <ros/param.h>
 #include <xmlrpcpp/XmlRpcValue.h>
@@ -168,8 +170,12 @@ NodeletConfig load_config(const ros::NodeHandle& nh) {
          "~model_description and ~object_link give the model");
   }
   read(nh, "mesh_scale", config.mesh_scale);
-  if (!(config.mesh_scale > 0.0) || !std::isfinite(config.mesh_scale))
-    fail("mesh_scale", "must be a positive finite number, got " + format(config.mesh_scale));
+  // Only the mesh is in model units: ~initial_pose and every published pose are metres (REP 103).
+  try {
+    kct::ModelUnits units(config.mesh_scale);  // the core's range for a model scale
+  } catch (const std::invalid_argument& e) {
+    fail("mesh_scale", e.what());
+  }
   // Optional: without it the nodelet waits for ~initial_pose (topic) or ~init (service).
   if (nh.hasParam("initial_pose/position") || nh.hasParam("initial_pose/orientation"))
     config.initial_pose = read_initial_pose(nh);

@@ -26,11 +26,6 @@ double elapsed_ms(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-bool has_pose(const kct::TrackResult& result) {
-  return result.status != kct::TrackStatus::kNotInitialized &&
-         result.status != kct::TrackStatus::kInvalidInput;
-}
-
 /// A mesh URL RViz can load for ~mesh_resource, "" when there is none (URDF model or a remote
 /// resource): then the marker is a triangle list.
 std::string rviz_mesh_url(const NodeletConfig& config) {
@@ -52,7 +47,6 @@ void TrackerNodelet::onInit() {
   try {
     config_ = load_config(private_nh);
     interface_ = load_interface_config(private_nh);
-    monitor_ = kct::TrackQualityMonitor(interface_.quality);
   } catch (const ConfigError& e) {
     NODELET_FATAL("invalid configuration, not tracking: %s", e.what());
     return;
@@ -65,6 +59,7 @@ void TrackerNodelet::onInit() {
 
   try {
     mesh_ = std::make_shared<const kct::Mesh>(load_model(config_));
+    session_ = std::make_unique<kct::TrackingSession>(mesh_, config_.params, interface_.quality);
   } catch (const std::exception& e) {
     NODELET_FATAL("invalid configuration, not tracking: %s", e.what());
     return;
@@ -74,7 +69,7 @@ void TrackerNodelet::onInit() {
                describe(config_).c_str(), describe(interface_).c_str());
 
   if (interface_.has_initial_pose) {
-    restart_pose_ = config_.initial_pose;
+    session_->set_restart_pose(config_.initial_pose);
     geometry_msgs::PoseStamped initial;  // empty frame_id: the camera frame
     initial.pose = to_pose_msg(config_.initial_pose);
     pending_pose_ = initial;
@@ -130,7 +125,7 @@ void TrackerNodelet::onInit() {
 // ---- Camera and frames ----------------------------------------------------------------------
 
 bool TrackerNodelet::update_camera(const sensor_msgs::CameraInfo& info, std::string& error) {
-  if (tracker_ && same_camera(info, camera_info_)) return true;
+  if (session_->has_camera() && same_camera(info, camera_info_)) return true;
   kct::PinholeCamera camera;
   try {
     camera = camera_from_info(info, config_.input_is_rectified);
@@ -138,13 +133,13 @@ bool TrackerNodelet::update_camera(const sensor_msgs::CameraInfo& info, std::str
     error = e.what();
     return false;
   }
-  if (!tracker_) {
-    tracker_ = std::make_unique<kct::Tracker>(mesh_, camera, config_.params);
+  if (!session_->has_camera()) {
+    session_->set_camera(camera);
     NODELET_INFO("tracker started: camera %dx%d, fx %.1f fy %.1f cx %.1f cy %.1f%s",
                  camera.width(), camera.height(), camera.fx(), camera.fy(), camera.cx(),
                  camera.cy(), camera.has_distortion() ? ", undistorting" : "");
   } else {
-    tracker_->set_camera(camera);
+    session_->set_camera(camera);
     NODELET_INFO("camera_info changed: camera %dx%d, fx %.1f fy %.1f cx %.1f cy %.1f",
                  camera.width(), camera.height(), camera.fx(), camera.fy(), camera.cx(),
                  camera.cy());
@@ -179,11 +174,11 @@ void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image,
     std::string camera_error;
     if (!update_camera(*info, camera_error)) {
       skip("unusable camera_info: " + camera_error);
-    } else if (static_cast<int>(image->width) != tracker_->camera().width() ||
-               static_cast<int>(image->height) != tracker_->camera().height()) {
+    } else if (static_cast<int>(image->width) != session_->tracker().camera().width() ||
+               static_cast<int>(image->height) != session_->tracker().camera().height()) {
       skip("image is " + std::to_string(image->width) + "x" + std::to_string(image->height) +
-           " but camera_info says " + std::to_string(tracker_->camera().width()) + "x" +
-           std::to_string(tracker_->camera().height()));
+           " but camera_info says " + std::to_string(session_->tracker().camera().width()) + "x" +
+           std::to_string(session_->tracker().camera().height()));
     } else {
       track(image, *status);
     }
@@ -192,9 +187,9 @@ void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image,
     NODELET_ERROR_THROTTLE(5.0, "frame %.3f failed: %s", image->header.stamp.toSec(), e.what());
     status->message = e.what();
   }
-  status->tracking_state = kct::to_string(monitor_.state());
-  status->energy_level = monitor_.energy_level();
-  status->bad_frames = monitor_.consecutive_bad_frames();
+  status->tracking_state = kct::to_string(session_->state());
+  status->energy_level = session_->monitor().energy_level();
+  status->bad_frames = session_->monitor().consecutive_bad_frames();
   status->frame_time_ms = elapsed_ms(start);
   status_pub_.publish(status);
   last_status_ = *status;
@@ -218,20 +213,8 @@ void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatu
   }
   frame.stamp_s = image->header.stamp.toSec();
 
-  if (!last_stamp_.isZero() && image->header.stamp < last_stamp_) {
-    // A looping bag: the old tf data and the track are stale.
-    tf_buffer_->clear();
-    if (restart_pose_ && monitor_.state() != kct::TrackState::kWaitingForPose) {
-      NODELET_INFO("image stamp jumped back from %.3f to %.3f s (bag loop?): re-initializing to "
-                   "the initial pose",
-                   last_stamp_.toSec(), image->header.stamp.toSec());
-      start_from(*restart_pose_);
-    } else {
-      NODELET_INFO("image stamp jumped back from %.3f to %.3f s (bag loop?)", last_stamp_.toSec(),
-                   image->header.stamp.toSec());
-    }
-  }
-  last_stamp_ = image->header.stamp;
+  // A looping bag: the old tf data are stale (the session restarts the track itself).
+  if (session_->time_jumps_back(frame.stamp_s)) tf_buffer_->clear();
   camera_frame_ = image->header.frame_id;
   if (!marker_published_) publish_marker(image->header.stamp);
 
@@ -240,10 +223,10 @@ void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatu
     pending_pose_.reset();
     try {
       const kct::Pose pose = to_camera_frame(given, image->header.frame_id, image->header.stamp);
-      start_from(pose);
+      session_->initialize(pose);
       // The parameter pose stays the restart pose; one given at run time replaces it only when
       // there is none (a looping bag restarts where the operator started it).
-      if (!restart_pose_) restart_pose_ = pose;
+      if (!session_->restart_pose()) session_->set_restart_pose(pose);
       NODELET_INFO("tracking from the given pose (frame '%s' -> '%s')",
                    given.header.frame_id.c_str(), image->header.frame_id.c_str());
     } catch (const std::exception& e) {
@@ -251,22 +234,19 @@ void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatu
     }
   }
 
-  const bool reacquiring = monitor_.should_reacquire();
-  const kct::TrackResult result =
-      reacquiring ? tracker_->reacquire(frame, monitor_.last_good_pose(),
-                                        monitor_.params().reacquire_search_scale)
-                  : tracker_->track(frame);
-  const kct::TrackState previous_state = monitor_.state();
-  const kct::TrackState state = monitor_.update(result);
-  if (state != previous_state) {
-    if (state == kct::TrackState::kLost)
-      NODELET_WARN("track LOST after %d bad frames (quality %.2f < %.2f): re-acquiring around "
-                   "the last good pose",
-                   monitor_.consecutive_bad_frames(), monitor_.last_quality(),
-                   monitor_.params().min_quality);
+  const kct::SessionResult session = session_->track(frame);
+  const kct::TrackResult& result = session.frame;
+  if (session.time_jumped_back)
+    NODELET_INFO("image stamp jumped back to %.3f s (bag loop?)%s", frame.stamp_s,
+                 session.restarted ? ": re-initialized to the initial pose" : "");
+  if (session.state_changed() && !session.restarted) {
+    if (session.state == kct::TrackState::kLost)
+      NODELET_WARN("track LOST after %d bad frames (quality %.2f < %.2f): re-acquiring",
+                   session_->monitor().consecutive_bad_frames(), session.quality,
+                   session_->quality_params().min_quality);
     else
-      NODELET_INFO("tracking state: %s -> %s", kct::to_string(previous_state),
-                   kct::to_string(state));
+      NODELET_INFO("tracking state: %s -> %s", kct::to_string(session.previous_state),
+                   kct::to_string(session.state));
   }
 
   status.state = kct::to_string(result.status);
@@ -279,8 +259,8 @@ void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatu
   status.hops = result.hops;
   status.track_time_ms = result.frame_time_ms;
   status.message = result.message;
-  status.quality = has_pose(result) ? monitor_.last_quality() : 0.0;
-  status.good = has_pose(result) && monitor_.last_good();
+  status.quality = session.quality;
+  status.good = session.good;
 
   if (result.status == kct::TrackStatus::kInvalidInput) {
     warn_skipped(result.message);
@@ -291,8 +271,8 @@ void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatu
                                "extrapolated before refinement",
                           result.keypoints.tracked, result.keypoints.inliers);
   }
-  const bool publish =
-      has_pose(result) && (state != kct::TrackState::kLost || interface_.publish_when_lost);
+  const bool publish = session.has_pose() &&
+                       (session.state != kct::TrackState::kLost || interface_.publish_when_lost);
   if (publish) publish_pose(image->header, result);
   status.pose_published = publish;
   if (debug_image_pub_.getNumSubscribers() > 0)
@@ -375,18 +355,12 @@ bool TrackerNodelet::on_init(Init::Request& request, Init::Response& response) {
 }
 
 bool TrackerNodelet::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-  if (tracker_) tracker_->reset();
-  monitor_.reset();
+  session_->reset();
   pending_pose_.reset();
   response.success = true;
   response.message = "track dropped: waiting for a pose on ~initial_pose or ~init";
   NODELET_INFO("~reset: %s", response.message.c_str());
   return true;
-}
-
-void TrackerNodelet::start_from(const kct::Pose& object_to_camera) {
-  tracker_->initialize(object_to_camera);  // throws std::invalid_argument for a bad pose
-  monitor_.on_initialized(object_to_camera);
 }
 
 // ---- Outputs --------------------------------------------------------------------------------
@@ -404,12 +378,12 @@ void TrackerNodelet::publish_pose(const std_msgs::Header& header, const kct::Tra
   const kct::KeypointInliers& inliers = result.keypoints.inlier_points;
   if (result.keypoints.success)
     covariance = kct::keypoint_pose_covariance(inliers.points_object, inliers.points_image,
-                                               tracker_->camera(), result.object_to_camera);
+                                               session_->tracker().camera(), result.object_to_camera);
   if (!covariance) {
     const double scale = result.status == kct::TrackStatus::kReacquired
-                             ? std::pow(monitor_.params().reacquire_search_scale, 2)
+                             ? std::pow(session_->quality_params().reacquire_search_scale, 2)
                              : 1.0;
-    covariance = kct::search_box_pose_covariance(mesh_->diameter(), tracker_->params(), scale);
+    covariance = kct::search_box_pose_covariance(mesh_->diameter(), session_->params(), scale);
   }
   auto with_covariance = boost::make_shared<geometry_msgs::PoseWithCovarianceStamped>();
   with_covariance->header = header;
@@ -466,25 +440,25 @@ void TrackerNodelet::publish_marker(const ros::Time& stamp) {
 void TrackerNodelet::publish_debug_image(const sensor_msgs::ImageConstPtr& image,
                                          const cv::Mat& frame, const kct::TrackResult& result,
                                          bool published) {
-  const kct::PinholeCamera& camera = tracker_->camera();
+  const kct::PinholeCamera& camera = session_->tracker().camera();
   cv::Mat input = frame;
   if (camera.has_distortion()) {
     // Drawn on the undistorted frame the tracker works on (ideal pinhole).
     if (debug_map_x_.empty()) camera.undistortion_maps(debug_map_x_, debug_map_y_);
     cv::remap(frame, input, debug_map_x_, debug_map_y_, cv::INTER_LINEAR);
   }
-  const std::string label = std::string(kct::to_string(monitor_.state())) +
-                            cv::format(" q %.2f", monitor_.last_quality()) +
+  const std::string label = std::string(kct::to_string(session_->state())) +
+                            cv::format(" q %.2f", session_->monitor().last_quality()) +
                             (published ? "" : " (not published)");
   cv_bridge::CvImage out(image->header, "bgr8",
                          kct::draw_tracking_overlay(input, result, camera, *mesh_,
-                                                    tracker_->contour_extractor(), label));
+                                                    session_->tracker().contour_extractor(), label));
   debug_image_pub_.publish(out.toImageMsg());
 }
 
 void TrackerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const kct::TrackState state = monitor_.state();
-  if (!tracker_)
+  const kct::TrackState state = session_->state();
+  if (!session_->has_camera())
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no usable image + camera_info yet");
   else if (state == kct::TrackState::kLost)
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "track lost: re-acquiring");
@@ -494,8 +468,8 @@ void TrackerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
   status.add("state", kct::to_string(state));
   status.add("last frame", last_status_.state);
-  status.add("quality", monitor_.last_quality());
-  status.add("consecutive bad frames", monitor_.consecutive_bad_frames());
+  status.add("quality", session_->monitor().last_quality());
+  status.add("consecutive bad frames", session_->monitor().consecutive_bad_frames());
   status.add("KLT inliers / tracked",
              std::to_string(last_status_.klt_inliers) + " / " + std::to_string(last_status_.klt_tracked));
   status.add("frame time (ms)", last_status_.frame_time_ms);
@@ -506,7 +480,7 @@ void TrackerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
 // ---- dynamic_reconfigure --------------------------------------------------------------------
 
 TrackerConfig TrackerNodelet::reconfigure_values() const {
-  const kct::TrackerParams& p = tracker_ ? tracker_->params() : config_.params;
+  const kct::TrackerParams& p = session_ ? session_->params() : config_.params;
   TrackerConfig c;
   c.preset = config_.preset;
   c.refine = p.refine;
@@ -522,15 +496,16 @@ TrackerConfig TrackerNodelet::reconfigure_values() const {
   c.klt_forward_backward_px = p.klt_forward_backward_px;
   c.ransac_reprojection_px = p.ransac_reprojection_px;
   c.klt_min_inlier_ratio = p.klt_min_inlier_ratio;
-  c.min_quality = monitor_.params().min_quality;
-  c.lost_after_bad_frames = monitor_.params().lost_after_bad_frames;
-  c.recover_after_good_frames = monitor_.params().recover_after_good_frames;
+  const kct::TrackQualityParams& q = session_ ? session_->quality_params() : interface_.quality;
+  c.min_quality = q.min_quality;
+  c.lost_after_bad_frames = q.lost_after_bad_frames;
+  c.recover_after_good_frames = q.recover_after_good_frames;
   c.publish_when_lost = interface_.publish_when_lost;
   return c;
 }
 
 void TrackerNodelet::on_reconfigure(TrackerConfig& config, uint32_t /*level*/) {
-  kct::TrackerParams params = tracker_ ? tracker_->params() : config_.params;
+  kct::TrackerParams params = session_->params();
   if (config.preset != config_.preset) {
     kct::TrackerParams preset;
     try {
@@ -565,7 +540,7 @@ void TrackerNodelet::on_reconfigure(TrackerConfig& config, uint32_t /*level*/) {
     params.ransac_reprojection_px = config.ransac_reprojection_px;
     params.klt_min_inlier_ratio = config.klt_min_inlier_ratio;
   }
-  kct::TrackQualityParams quality = monitor_.params();
+  kct::TrackQualityParams quality = session_->quality_params();
   quality.min_quality = config.min_quality;
   quality.lost_after_bad_frames = config.lost_after_bad_frames;
   quality.recover_after_good_frames = config.recover_after_good_frames;
@@ -578,8 +553,8 @@ void TrackerNodelet::on_reconfigure(TrackerConfig& config, uint32_t /*level*/) {
     return;
   }
   config_.params = params;
-  if (tracker_) tracker_->set_params(params);
-  monitor_.set_params(quality);
+  session_->set_params(params);
+  session_->set_quality_params(quality);
   interface_.quality = quality;
   interface_.publish_when_lost = config.publish_when_lost;
   // Pushed back to the server: a preset's values, or the values as applied.

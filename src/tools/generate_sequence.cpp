@@ -22,6 +22,7 @@
 #include <string>
 
 #include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/model_units.h"
 #include "klt_contour_tracker/core/renderer.h"
 #include "klt_contour_tracker/core/sequence_io.h"
 #include "klt_contour_tracker/core/trajectory.h"
@@ -34,7 +35,9 @@ constexpr double kFirstStamp_s = 1000.0;
 
 const char* kUsage =
     "usage: generate_sequence --model MESH --output-dir DIR [options]\n"
-    "  --model-scale S          multiply mesh coordinates (0.001 for millimetres) [1]\n"
+    "  --model-scale S          metres per model unit (0.001 for millimetres) [1]: the mesh is\n"
+    "                           read and pose.txt written in model units (track_sequence reads\n"
+    "                           them back with the same --model-scale); the bag is metres (REP 103)\n"
     "  --bag FILE.bag           also write /camera/image_raw, /camera/camera_info,\n"
     "                           /ground_truth/pose at 30 Hz stamps from t = 1000 s\n"
     "  --frames N               number of frames [150]\n"
@@ -178,7 +181,8 @@ geometry_msgs::PoseStamped to_pose_message(const kct::Pose& pose, const std_msgs
 }
 
 int run(const Options& o) {
-  auto mesh = std::make_shared<const kct::Mesh>(kct::load_mesh(o.model, o.model_scale));
+  const kct::ModelUnits units(o.model_scale);
+  auto mesh = std::make_shared<const kct::Mesh>(kct::load_mesh(o.model, units.metres_per_unit()));
   const kct::PinholeCamera camera(o.fx, o.fy, o.cx, o.cy, o.width, o.height);
   const kct::SyntheticTrajectory trajectory(o.trajectory, camera, mesh->bounding_box_center(),
                                             mesh->diameter());
@@ -244,7 +248,7 @@ int run(const Options& o) {
       bag->write("/ground_truth/pose", header.stamp, to_pose_message(pose, header));
     }
   }
-  kct::write_pose_file(folder + "pose.txt", poses);
+  kct::write_pose_file(folder + "pose.txt", poses, units);  // model units, as the mesh
   if (bag) bag->close();
 
   std::cout << "wrote " << o.frames << " frames (" << kct::to_string(o.trajectory.motion)

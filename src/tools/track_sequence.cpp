@@ -1,9 +1,10 @@
 // track_sequence: tracks a sequence folder (BCOT / RBOT-style: images, K.txt, pose.txt) offline
-// and scores it with the paper's metric (Sec. 4.1). Needs no ROS master.
+// and scores it with the paper's metric (Sec. 4.1), through the same TrackingSession as the
+// nodelet (loss detection and re-acquisition included). Needs no ROS master.
 //
 //   track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]
 //                  [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]
-//                  [--max-frames N] [--errors FILE] [--debug-dir DIR [--debug-every N]] [--quiet]
+//                  [--max-frames N] [--max-image-pixels N] [--errors FILE] [--debug-dir DIR [--debug-every N]] [--quiet]
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -17,7 +18,9 @@
 
 #include "klt_contour_tracker/core/debug_drawing.h"
 #include "klt_contour_tracker/core/metrics.h"
+#include "klt_contour_tracker/core/model_units.h"
 #include "klt_contour_tracker/core/sequence_io.h"
+#include "klt_contour_tracker/core/sequence_run.h"
 #include "klt_contour_tracker/core/tracker.h"
 
 namespace {
@@ -26,15 +29,21 @@ void usage(const char* error) {
   if (error) std::cerr << "track_sequence: " << error << "\n";
   std::cerr << "usage: track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]\n"
                "                      [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]\n"
-               "                      [--max-frames N] [--errors FILE] [--debug-dir DIR [--debug-every N]]\n"
-               "                      [--quiet]\n"
+               "                      [--max-frames N] [--max-image-pixels N] [--errors FILE]\n"
+               "                      [--debug-dir DIR [--debug-every N]] [--quiet]\n"
+               "  --model-scale S: metres per model unit (0.001 for millimetres). It applies to\n"
+               "  everything in model units: the mesh, pose.txt as read, the poses written by --output\n"
+               "  (in model units, as read). Errors and ADD are reported in metres / mm regardless.\n"
+               "  --max-image-pixels N: frames larger than N pixels (from the file header) are refused\n"
+               "  before decoding, with a per-frame error [16777216 = 4096x4096].\n"
                "  The visibility table is cached in $XDG_CACHE_HOME (~/.cache)/klt_contour_tracker/visibility\n"
                "  (--param visibility_cache_dir=DIR to change, =\"\" for none).\n"
-               "  --errors FILE writes the per-frame error delta_i (Sec. 4.1, model units), one a line.\n"
+               "  --errors FILE writes the per-frame error delta_i (Sec. 4.1, metres), one a line.\n"
                "  --debug-dir DIR writes the tracking overlay (contour, keypoints, axes, status) of every\n"
                "  N-th frame (default 1) as DIR/<frame>.png.\n"
                "  DIR holds images (sorted by name), K.txt and pose.txt (first line = initial pose;\n"
-               "  the rest, when present, is the ground truth used for scoring).\n"
+               "  the rest, when present, is the ground truth used for scoring; with the initial pose alone\n"
+               "  the run is not scored and --errors fails).\n"
                "  presets: ";
   for (const auto& name : kct::preset_names()) std::cerr << name << " ";
   std::cerr << "\n";
@@ -46,6 +55,7 @@ struct Options {
   int debug_every = 1;
   double model_scale = 1.0;
   int max_frames = -1;
+  long long max_image_pixels = 4096LL * 4096;
   bool quiet = false;
   std::vector<std::pair<std::string, std::string>> overrides;
 };
@@ -67,6 +77,7 @@ Options parse(int argc, char** argv) {
       else if (arg == "--summary-json") o.summary_json = value();
       else if (arg == "--errors") o.errors = value();
       else if (arg == "--max-frames") o.max_frames = std::stoi(value());
+      else if (arg == "--max-image-pixels") o.max_image_pixels = std::stoll(value());
       else if (arg == "--quiet") o.quiet = true;
       else if (arg == "--debug-dir") o.debug_dir = value();
       else if (arg == "--debug-every") o.debug_every = std::max(1, std::stoi(value()));
@@ -87,93 +98,137 @@ Options parse(int argc, char** argv) {
 
 }  // namespace
 
+namespace {
+
+/// The tracker parameters: the preset, the visibility cache in $XDG_CACHE_HOME, the overrides.
+kct::TrackerParams make_params(const Options& options) {
+  kct::TrackerParams params = kct::make_preset(options.preset);
+  // The visibility table is cached per model: a second run on the same model starts at once.
+  if (const char* home = std::getenv("HOME"); home && *home) {
+    const char* xdg = std::getenv("XDG_CACHE_HOME");
+    params.visibility_cache_dir = (xdg && *xdg ? std::string(xdg) : std::string(home) + "/.cache") +
+                                  "/klt_contour_tracker/visibility";
+  }
+  for (const auto& [name, value] : options.overrides) kct::set_param(params, name, value);
+  params.validate();
+  return params;
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string join(const std::vector<int>& values) {
+  std::string out;
+  for (int v : values) out += (out.empty() ? "" : ", ") + std::to_string(v);
+  return out;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   const Options options = parse(argc, argv);
   try {
-    kct::TrackerParams params = kct::make_preset(options.preset);
-    // The visibility table is cached per model: a second run on the same model starts at once.
-    if (const char* home = std::getenv("HOME"); home && *home) {
-      const char* xdg = std::getenv("XDG_CACHE_HOME");
-      params.visibility_cache_dir = (xdg && *xdg ? std::string(xdg) : std::string(home) + "/.cache") +
-                                    "/klt_contour_tracker/visibility";
-    }
-    for (const auto& [name, value] : options.overrides) kct::set_param(params, name, value);
-    params.validate();
-
-    const kct::SequenceFolder sequence = kct::read_sequence(options.sequence);
+    const kct::TrackerParams params = make_params(options);
+    // Units: the mesh and pose.txt are in model units; everything inside is metres. The one
+    // conversion happens at the I/O boundary (read_sequence, write_pose_file, load_mesh).
+    const kct::ModelUnits units(options.model_scale);
+    const kct::SequenceFolder sequence = kct::read_sequence(options.sequence, units);
     if (sequence.poses.empty())
       throw std::runtime_error(options.sequence + "/pose.txt: missing; its first line is the initial pose");
-    auto mesh = std::make_shared<kct::Mesh>(kct::load_mesh(options.model, options.model_scale));
-    size_t frames = sequence.image_paths.size();
-    if (options.max_frames > 0) frames = std::min(frames, static_cast<size_t>(options.max_frames));
-
-    const cv::Mat first = cv::imread(sequence.image_paths.front(), cv::IMREAD_COLOR);
-    if (first.empty()) throw std::runtime_error(sequence.image_paths.front() + ": cannot read image");
-    const kct::PinholeCamera camera = kct::PinholeCamera::from_matrix(sequence.K, first.cols, first.rows);
-    kct::Tracker tracker(mesh, camera, params);
-    tracker.initialize(sequence.poses.front());
+    auto mesh = std::make_shared<kct::Mesh>(kct::load_mesh(options.model, units.metres_per_unit()));
 
     if (!options.debug_dir.empty()) std::filesystem::create_directories(options.debug_dir);
-    std::vector<kct::Pose> estimated;
-    std::vector<double> frame_ms;
-    int extrapolated = 0;
-    for (size_t i = 0; i < frames; ++i) {
-      const cv::Mat image = cv::imread(sequence.image_paths[i], cv::IMREAD_COLOR);
-      if (image.empty()) throw std::runtime_error(sequence.image_paths[i] + ": cannot read image");
-      const kct::TrackResult result = tracker.track({image, static_cast<double>(i)});
-      if (result.status == kct::TrackStatus::kInvalidInput)
-        throw std::runtime_error(sequence.image_paths[i] + ": " + result.message);
-      estimated.push_back(result.object_to_camera);
-      if (i > 0) frame_ms.push_back(result.frame_time_ms);
-      if (result.status == kct::TrackStatus::kExtrapolated) ++extrapolated;
-      if (!options.debug_dir.empty() && i % options.debug_every == 0) {
+    kct::SequenceRunOptions run_options;
+    run_options.max_frames = options.max_frames > 0 ? static_cast<size_t>(options.max_frames) : 0;
+    run_options.max_image_pixels = options.max_image_pixels;
+    size_t frames = sequence.image_paths.size();
+    if (options.max_frames > 0) frames = std::min(frames, static_cast<size_t>(options.max_frames));
+    run_options.on_frame = [&](size_t i, const cv::Mat& image, const kct::SessionResult& result,
+                               const kct::TrackingSession& session) {
+      if (result.frame.status == kct::TrackStatus::kInvalidInput)
+        std::cerr << (options.quiet ? "" : "\n") << "track_sequence: frame " << i << " skipped: "
+                  << result.frame.message << "\n";
+      if (!options.debug_dir.empty() && i % options.debug_every == 0 && !image.empty()) {
         const std::string path = options.debug_dir + "/" + kct::frame_file_name(static_cast<int>(i));
-        if (!cv::imwrite(path, kct::draw_tracking_overlay(image, result, tracker.camera(), *mesh,
-                                                         tracker.contour_extractor())))
+        const std::string label = std::string(kct::to_string(result.state)) +
+                                  cv::format(" q %.2f", result.quality);
+        if (!cv::imwrite(path, kct::draw_tracking_overlay(image, result.frame, session.tracker().camera(),
+                                                         *mesh, session.tracker().contour_extractor(), label)))
           throw std::runtime_error(path + ": cannot write");
       }
       if (!options.quiet) {
-        std::cerr << "\r[" << (i + 1) << "/" << frames << "] " << std::setw(12) << kct::to_string(result.status)
-                  << "  " << std::fixed << std::setprecision(1) << result.frame_time_ms << " ms" << std::flush;
+        std::cerr << "\r[" << (i + 1) << "/" << frames << "] " << std::setw(12)
+                  << kct::to_string(result.frame.status) << " " << std::setw(8) << kct::to_string(result.state)
+                  << "  " << std::fixed << std::setprecision(1) << result.frame.frame_time_ms << " ms"
+                  << std::flush;
       }
-    }
+    };
+    const kct::SequenceRun run = kct::track_sequence_folder(sequence, mesh, params, run_options);
     if (!options.quiet) std::cerr << "\n";
-    if (!options.output.empty()) kct::write_pose_file(options.output, estimated);
+    frames = run.object_to_camera.size();
+    if (!options.output.empty()) kct::write_pose_file(options.output, run.object_to_camera, units);
+
+    const kct::SessionStatistics& stats = run.statistics;
+    std::ostringstream json;
+    json << std::setprecision(6) << "{\n  \"sequence\": " << json_string(options.sequence)
+         << ",\n  \"preset\": " << json_string(options.preset) << ",\n  \"frames\": " << frames
+         << ",\n  \"model_scale\": " << units.metres_per_unit()
+         << ",\n  \"faces\": " << mesh->faces.size() << ",\n  \"vertices\": " << mesh->vertices.size()
+         << ",\n  \"width\": " << run.camera.width() << ",\n  \"height\": " << run.camera.height()
+         << ",\n  \"extrapolated_frames\": " << run.extrapolated
+         << ",\n  \"invalid_frames\": " << stats.invalid_frames
+         << ",\n  \"frames_lost\": " << stats.frames_lost << ",\n  \"losses\": " << stats.losses
+         << ",\n  \"reacquisitions\": " << stats.reacquisitions
+         << ",\n  \"frames_to_reacquire\": [" << join(stats.frames_to_reacquire) << "]"
+         << ",\n  \"median_ms\": " << kct::median(run.frame_ms);
+    std::printf("frames            %zu\n", frames);
+    std::printf("invalid_frames    %d\n", stats.invalid_frames);
+    std::printf("extrapolated      %d\n", run.extrapolated);
+    std::printf("frames_lost       %d\n", stats.frames_lost);
+    std::printf("losses            %d\n", stats.losses);
+    std::printf("reacquisitions    %d  (frames from loss to re-acquired: %s)\n", stats.reacquisitions,
+                stats.frames_to_reacquire.empty() ? "-" : join(stats.frames_to_reacquire).c_str());
+    std::printf("median_ms         %.2f\n", kct::median(run.frame_ms));
 
     // Score the frames that have ground truth (pose.txt may hold more lines than images).
-    const size_t scored = std::min(frames, sequence.poses.size());
-    std::ostringstream json;
-    json << std::setprecision(6) << "{\n  \"sequence\": \"" << options.sequence << "\",\n  \"preset\": \""
-         << options.preset << "\",\n  \"frames\": " << frames << ",\n  \"faces\": " << mesh->faces.size()
-         << ",\n  \"vertices\": " << mesh->vertices.size() << ",\n  \"width\": " << camera.width()
-         << ",\n  \"height\": " << camera.height() << ",\n  \"extrapolated_frames\": " << extrapolated
-         << ",\n  \"median_ms\": " << kct::median(frame_ms);
-    std::printf("frames            %zu\n", frames);
-    std::printf("extrapolated      %d\n", extrapolated);
-    std::printf("median_ms         %.2f\n", kct::median(frame_ms));
-    if (scored > 1) {
-      std::vector<double> deltas;
-      const std::vector<kct::Pose> truth(sequence.poses.begin(), sequence.poses.begin() + scored);
-      const std::vector<kct::Pose> mine(estimated.begin(), estimated.begin() + scored);
-      for (size_t i = 0; i < scored; ++i)
-        deltas.push_back(kct::mean_vertex_distance(mesh->vertices, mine[i], truth[i]));
+    int exit_code = 0;
+    if (sequence.poses.size() < 2) {
+      // pose.txt holds only the initial pose: a tracking run, nothing to score against.
+      std::printf("auc               not scored: pose.txt has %zu pose (the initial one); scoring needs one per frame\n",
+                  sequence.poses.size());
+      json << ",\n  \"scored_frames\": 0";
+      if (!options.errors.empty()) {
+        std::cerr << "track_sequence: --errors " << options.errors
+                  << " not written: pose.txt has only the initial pose, no ground truth to score against\n";
+        exit_code = 1;
+      }
+    } else {
+      const kct::SequenceScore score = kct::score_sequence(*mesh, run.object_to_camera, sequence.poses);
+      if (score.scored_frames < frames)
+        std::cerr << "track_sequence: warning: pose.txt has " << sequence.poses.size() << " poses for "
+                  << frames << " frames: only the first " << score.scored_frames << " are scored\n";
       if (!options.errors.empty()) {
         std::ofstream out(options.errors);
         out << std::setprecision(9);
-        for (double d : deltas) out << d << "\n";
+        for (double d : score.errors_m) out << d << "\n";
         if (!out) throw std::runtime_error(options.errors + ": cannot write");
       }
-      double mean_add = 0;
-      for (double d : deltas) mean_add += d;
-      mean_add /= deltas.size();
-      const double auc = kct::auc_score(deltas, mesh->diameter());
-      const double success = kct::success_translation_rotation(mine, truth, 0.05, 5.0);
-      std::printf("auc               %.3f  (of 20; k in [0, 0.2], diameter %.4f m)\n", auc, mesh->diameter());
-      std::printf("success_5cm5deg   %.4f\n", success);
-      std::printf("mean_add_mm       %.3f\n", 1000.0 * mean_add);
-      json << ",\n  \"scored_frames\": " << scored << ",\n  \"auc\": " << auc
-           << ",\n  \"success_5cm5deg\": " << success << ",\n  \"mean_add_mm\": " << 1000.0 * mean_add
-           << ",\n  \"diameter_m\": " << mesh->diameter();
+      std::printf("scored_frames     %zu\n", score.scored_frames);
+      std::printf("auc               %.3f  (of 20; k in [0, 0.2], diameter %.4f m)\n", score.auc,
+                  score.diameter_m);
+      std::printf("success_5cm5deg   %.4f\n", score.success_5cm5deg);
+      std::printf("mean_add_mm       %.3f\n", 1000.0 * score.mean_add_m);
+      json << ",\n  \"scored_frames\": " << score.scored_frames << ",\n  \"auc\": " << score.auc
+           << ",\n  \"success_5cm5deg\": " << score.success_5cm5deg
+           << ",\n  \"mean_add_mm\": " << 1000.0 * score.mean_add_m
+           << ",\n  \"diameter_m\": " << score.diameter_m;
     }
     json << "\n}\n";
     if (!options.summary_json.empty()) {
@@ -181,9 +236,9 @@ int main(int argc, char** argv) {
       out << json.str();
       if (!out) throw std::runtime_error(options.summary_json + ": cannot write");
     }
+    return exit_code;
   } catch (const std::exception& e) {
     std::cerr << "track_sequence: " << e.what() << "\n";
     return 1;
   }
-  return 0;
 }

@@ -117,3 +117,33 @@ TEST_F(SequenceIo, MissingOrBadIntrinsicsAndEmptyFolders) {
   expect_error([&] { kct::read_sequence(dir_.string()); }, {"no images", dir_.string()});
   expect_error([&] { kct::read_sequence(file("nope")); }, {file("nope")});
 }
+
+TEST_F(SequenceIo, ImageSizeFromTheHeaderOfPngJpegAndBmp) {
+  const cv::Mat image(37, 61, CV_8UC3, cv::Scalar(10, 200, 30));
+  for (const std::string name : {"a.png", "b.jpg", "c.bmp"}) {
+    ASSERT_TRUE(cv::imwrite(file(name), image)) << name;
+    const cv::Size size = kct::read_image_size(file(name));
+    EXPECT_EQ(size, cv::Size(61, 37)) << name;
+  }
+  const cv::Mat grey(480, 640, CV_8UC1, cv::Scalar(7));
+  ASSERT_TRUE(cv::imwrite(file("grey.jpg"), grey));
+  EXPECT_EQ(kct::read_image_size(file("grey.jpg")), cv::Size(640, 480));
+  write_text("text.png", "not an image");
+  expect_error([&] { kct::read_image_size(file("text.png")); }, {"text.png", "not a PNG, JPEG or BMP"});
+  write_text("short.png", "\x89PNG");
+  expect_error([&] { kct::read_image_size(file("short.png")); }, {"short.png", "truncated"});
+  expect_error([&] { kct::read_image_size(file("missing.png")); }, {"missing.png", "cannot open"});
+}
+
+TEST_F(SequenceIo, PosesAreConvertedFromModelUnitsOnReadAndBackOnWrite) {
+  kct::Pose pose = kct::Pose::Identity();
+  pose.translation() = Eigen::Vector3d(0.01, 0.02, 0.5);
+  write_text("K.txt", "500 0 320\n0 500 240\n0 0 1\n");
+  cv::imwrite(file("000000.png"), cv::Mat(4, 4, CV_8UC1, cv::Scalar(0)));
+  kct::write_pose_file(file("pose.txt"), {pose}, kct::ModelUnits(0.001));
+  EXPECT_NEAR(kct::read_pose_file(file("pose.txt"))[0].translation().z(), 500.0, 1e-9);
+  const kct::SequenceFolder in_mm = kct::read_sequence(dir_.string(), kct::ModelUnits(0.001));
+  EXPECT_NEAR((in_mm.poses[0].translation() - pose.translation()).norm(), 0.0, 1e-15);
+  // Read as metres, the same file puts the object 500 m away: the unit is the caller's to give.
+  EXPECT_NEAR(kct::read_sequence(dir_.string()).poses[0].translation().z(), 500.0, 1e-9);
+}

@@ -1,11 +1,13 @@
 #pragma once
 /// \file tracker_nodelet.h
-/// ROS wrapper of kct::Tracker. Subscribes `image` + `camera_info` (image_transport camera
+/// ROS wrapper of kct::TrackingSession. Subscribes `image` + `camera_info` (image_transport camera
 /// subscriber, resolved in the nodelet's namespace) and `~initial_pose`; serves `~init` and
 /// `~reset`; publishes `~pose`, `~pose_with_covariance` (object_to_camera in the image's optical
 /// frame, header = the image's header), `~status`, `~debug_image`, `~marker`, the tf image frame
-/// -> ~object_frame and /diagnostics. A kct::TrackQualityMonitor runs the WAITING_FOR_POSE /
-/// TRACKING / LOST state machine; while LOST the tracker re-acquires around the last good pose.
+/// -> ~object_frame and /diagnostics. The session (the same core code as track_sequence and the
+/// benchmark) runs the pipeline, the WAITING_FOR_POSE / TRACKING / LOST state machine,
+/// re-acquisition while LOST and the restart on a backward time jump; the nodelet converts
+/// messages and publishes. Poses in and out are metres (REP 103), whatever ~mesh_scale.
 /// All work is done in callbacks on the nodelet's single-threaded callback queue.
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -33,6 +35,7 @@
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/track_quality.h"
 #include "klt_contour_tracker/core/tracker.h"
+#include "klt_contour_tracker/core/tracking_session.h"
 #include "klt_contour_tracker/ros/interface_config.h"
 #include "klt_contour_tracker/ros/param_loader.h"
 
@@ -51,7 +54,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   /// One frame: camera update, conversion, tracking, publishing; a ~status for every image.
   void on_image(const sensor_msgs::ImageConstPtr& image,
                 const sensor_msgs::CameraInfoConstPtr& info);
-  /// Creates the tracker on the first usable camera_info and updates its camera when it
+  /// Creates the session's tracker on the first usable camera_info and updates its camera when it
   /// changes. Returns false with the reason in `error` when the camera_info is unusable.
   bool update_camera(const sensor_msgs::CameraInfo& info, std::string& error);
   /// Tracks one image whose size matches the camera; fills `status`, publishes the outputs.
@@ -70,9 +73,6 @@ class TrackerNodelet : public nodelet::Nodelet {
   /// fixed; latest tf when `stamp` is not available). Throws std::runtime_error.
   kct::Pose to_camera_frame(const geometry_msgs::PoseStamped& pose, const std::string& camera_frame,
                             const ros::Time& stamp) const;
-  /// Starts tracking from `object_to_camera` on the next track() call.
-  void start_from(const kct::Pose& object_to_camera);
-
   /// dynamic_reconfigure: a changed preset loads the preset's values into `config` (pushed back
   /// to the server); other changes are validated and applied, or reverted with a warning.
   void on_reconfigure(TrackerConfig& config, uint32_t level);
@@ -89,11 +89,11 @@ class TrackerNodelet : public nodelet::Nodelet {
   NodeletConfig config_;
   InterfaceConfig interface_;
   std::shared_ptr<const kct::Mesh> mesh_;
-  std::unique_ptr<kct::Tracker> tracker_;
-  kct::TrackQualityMonitor monitor_;
+  /// Pipeline, quality monitor, re-acquisition, restart pose (~initial_pose parameter, or the
+  /// first pose given at run time); created in onInit once the model is loaded.
+  std::unique_ptr<kct::TrackingSession> session_;
   sensor_msgs::CameraInfo camera_info_;  ///< the camera the tracker currently uses
   cv::Mat debug_map_x_, debug_map_y_;    ///< undistortion of the debug image (raw input)
-  ros::Time last_stamp_;
   /// Logs a skipped frame's reason: at once when the reason changes, else at most every 5 s
   /// (a throttle per call site would hide a new kind of bad input behind the previous one).
   void warn_skipped(const std::string& reason);
@@ -101,7 +101,6 @@ class TrackerNodelet : public nodelet::Nodelet {
   ros::WallTime last_skip_log_;
   std::string camera_frame_;  ///< frame_id of the last image
   std::optional<geometry_msgs::PoseStamped> pending_pose_;  ///< applied on the next image
-  std::optional<kct::Pose> restart_pose_;  ///< re-applied on a backward time jump
   bool marker_published_ = false;
   // Statistics for diagnostics.
   TrackerStatus last_status_;

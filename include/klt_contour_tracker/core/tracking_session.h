@@ -1,0 +1,114 @@
+#pragma once
+/// \file tracking_session.h
+/// One tracking session, the same for every front end (nodelet, track_sequence, benchmark,
+/// demo): the per-frame pipeline (Tracker), the quality monitor and its TRACKING / LOST state
+/// machine (TrackQualityMonitor), re-acquisition while lost, and a restart from a given pose
+/// when time jumps backwards (a looping bag), behind one track() call. Ours; the paper has no
+/// failure handling. The session owns no thread and does no I/O.
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "klt_contour_tracker/core/camera.h"
+#include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/track_quality.h"
+#include "klt_contour_tracker/core/tracker.h"
+#include "klt_contour_tracker/core/tracker_params.h"
+
+namespace kct {
+
+/// What one TrackingSession::track() call did.
+struct SessionResult {
+  TrackResult frame;                                   ///< the pipeline's result (poses in metres)
+  TrackState previous_state = TrackState::kWaitingForPose;  ///< state before this frame
+  TrackState state = TrackState::kWaitingForPose;      ///< state after this frame
+  double quality = 0.0;      ///< the monitor's score in [0, 1]; 0 when the frame has no pose
+  bool good = false;         ///< quality >= min_quality (and the frame has a pose)
+  bool reacquiring = false;  ///< the frame ran re-acquisition instead of tracking
+  bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
+  bool restarted = false;    ///< ... and the session restarted from restart_pose()
+  /// True unless the status is kNotInitialized or kInvalidInput.
+  bool has_pose() const;
+  /// The state changed on this frame.
+  bool state_changed() const { return state != previous_state; }
+};
+
+/// Counters of a session since its construction or the last clear_statistics().
+struct SessionStatistics {
+  int frames = 0;          ///< frames passed to track()
+  int invalid_frames = 0;  ///< frames rejected as kInvalidInput
+  int frames_lost = 0;     ///< frames that ended in state LOST
+  int losses = 0;          ///< TRACKING -> LOST transitions
+  int reacquisitions = 0;  ///< LOST -> TRACKING transitions
+  int restarts = 0;        ///< restarts from restart_pose() on a backward time jump
+  /// For each re-acquisition: frames from the one that declared the loss to the one that
+  /// declared the track good again (>= recover_after_good_frames).
+  std::vector<int> frames_to_reacquire;
+};
+
+/// Tracks one rigid object in one camera's stream with loss detection and re-acquisition.
+/// Poses are object_to_camera, metres.
+class TrackingSession {
+ public:
+  /// Throws std::invalid_argument for an empty mesh or parameters that do not validate.
+  TrackingSession(std::shared_ptr<const Mesh> mesh, const TrackerParams& params,
+                  const TrackQualityParams& quality = {});
+  ~TrackingSession();
+
+  /// Sets the intrinsics: the first call creates the tracker (building or loading its
+  /// visibility table), later ones keep the track. Throws std::invalid_argument for a camera
+  /// without image size.
+  void set_camera(const PinholeCamera& camera);
+  bool has_camera() const { return tracker_ != nullptr; }
+
+  /// The next frame has this pose; TRACKING from it. Throws std::invalid_argument for an invalid
+  /// pose or one behind the camera, std::logic_error before set_camera().
+  void initialize(const Pose& object_to_camera);
+  /// Drops the track: WAITING_FOR_POSE until initialize(). Keeps the restart pose.
+  void reset();
+  /// Pose re-applied when a frame's stamp is earlier than the previous frame's while a track
+  /// is held (a looping bag restarts where the operator started it); none = keep tracking.
+  void set_restart_pose(const std::optional<Pose>& object_to_camera) { restart_pose_ = object_to_camera; }
+  const std::optional<Pose>& restart_pose() const { return restart_pose_; }
+  /// True when a frame stamped `stamp_s` would be a backward time jump.
+  bool time_jumps_back(double stamp_s) const { return has_last_stamp_ && stamp_s < last_stamp_s_; }
+
+  /// One frame: restart on a backward time jump (when a restart pose is set and no pose was
+  /// given since the last frame), then the pipeline, or re-acquisition while LOST and the last
+  /// frame was bad; then the monitor's verdict. Before set_camera() the result is
+  /// kNotInitialized. Exceptions of the pipeline (e.g. a failing OpenCV call) propagate.
+  SessionResult track(const Frame& frame);
+
+  TrackState state() const { return monitor_.state(); }
+  const TrackQualityMonitor& monitor() const { return monitor_; }
+  /// The pipeline; std::logic_error before set_camera().
+  const Tracker& tracker() const;
+  const Mesh& mesh() const { return *mesh_; }
+  const TrackerParams& params() const { return params_; }
+  const TrackQualityParams& quality_params() const { return monitor_.params(); }
+  /// Validate and replace the parameters (std::invalid_argument); keep the track.
+  void set_params(const TrackerParams& params);
+  void set_quality_params(const TrackQualityParams& quality);
+
+  const SessionStatistics& statistics() const { return statistics_; }
+  void clear_statistics() { statistics_ = {}; }
+
+ private:
+  TrackResult reacquire(const Frame& frame);
+  void count(const SessionResult& result);
+
+  std::shared_ptr<const Mesh> mesh_;
+  TrackerParams params_;
+  TrackQualityMonitor monitor_;
+  std::unique_ptr<Tracker> tracker_;
+  std::optional<Pose> restart_pose_;
+  bool initialized_since_last_frame_ = false;
+  bool has_last_stamp_ = false;
+  double last_stamp_s_ = 0.0;
+  int lost_at_frame_ = -1;  ///< statistics_.frames when the current loss was declared
+  SessionStatistics statistics_;
+};
+
+}  // namespace kct

@@ -1,0 +1,148 @@
+// TrackingSession: the pipeline + loss detection + re-acquisition + restart on a backward time
+// jump behind one track() call. A coarse visibility table keeps the test quick.
+#include <gtest/gtest.h>
+
+#include "klt_contour_tracker/core/tracking_session.h"
+#include "synthetic_scene.h"
+
+namespace kct {
+namespace {
+
+TrackerParams quick_paper() {
+  TrackerParams params = make_preset("paper");
+  params.icosphere_subdivisions = 2;
+  params.visibility_resolution_px = 128;
+  params.visibility_cache_dir = "";
+  return params;
+}
+
+struct Scene {
+  std::shared_ptr<Mesh> mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  Renderer renderer{mesh};
+  PinholeCamera camera = test::make_camera();
+  cv::Mat background = test::make_background(camera.size(), 5);
+  /// The object's pose at frame i: a slow drift.
+  Pose pose(int i) const {
+    return test::move(test::make_pose(0.45), 0.5 * i, {0.2, 1.0, 0.0}, {0.0015 * i, -0.0005 * i, 0.0});
+  }
+  cv::Mat visible(int i) const { return test::render_frame(renderer, camera, pose(i), background, 1.5, i); }
+  /// The object hidden: the background alone.
+  cv::Mat hidden(int i) const {
+    cv::Mat frame = background.clone();
+    cv::Mat noise(frame.size(), CV_8UC3);
+    cv::RNG(i).fill(noise, cv::RNG::UNIFORM, 0, 3);
+    return frame + noise;
+  }
+};
+
+TEST(TrackingSession, LosesTheHiddenObjectAndReacquiresItWhenItComesBack) {
+  const Scene scene;
+  TrackingSession session(scene.mesh, quick_paper());
+  EXPECT_FALSE(session.has_camera());
+  EXPECT_EQ(session.track({scene.visible(0), 0.0}).frame.status, TrackStatus::kNotInitialized);
+  session.set_camera(scene.camera);
+  session.initialize(scene.pose(0));
+  int frame = 0;
+  double stamp = 1.0;
+  // Frames 0-5 visible: tracked.
+  for (; frame < 6; ++frame, stamp += 0.033) {
+    const SessionResult r = session.track({scene.visible(frame), stamp});
+    ASSERT_TRUE(r.has_pose());
+    EXPECT_EQ(r.state, TrackState::kTracking) << frame;
+    EXPECT_LT(translation_error(r.frame.object_to_camera, scene.pose(frame)), 0.005) << frame;
+  }
+  // Frames 6-17 hidden: LOST within lost_after_bad_frames (5) + 2 frames (the energy level
+  // drops at once when the contour sits on background only; KLT fails at once).
+  int lost_at = -1;
+  for (; frame < 18; ++frame, stamp += 0.033) {
+    const SessionResult r = session.track({scene.hidden(frame), stamp});
+    if (r.state == TrackState::kLost && lost_at < 0) lost_at = frame;
+  }
+  ASSERT_GE(lost_at, 6);
+  EXPECT_LE(lost_at, 6 + 5 + 2);
+  EXPECT_EQ(session.state(), TrackState::kLost);
+  EXPECT_EQ(session.statistics().losses, 1);
+  EXPECT_GE(session.statistics().frames_lost, 18 - (6 + 5 + 2));
+  // Back in view where it was lost (slow drift): re-acquired within 10 frames, pose right.
+  int back_at = -1;
+  for (int k = 0; k < 10; ++k, ++frame, stamp += 0.033) {
+    const SessionResult r = session.track({scene.visible(6 + k), stamp});
+    if (k == 0) {
+      EXPECT_TRUE(r.reacquiring);
+    }
+    if (r.state == TrackState::kTracking) {
+      back_at = k;
+      EXPECT_LT(translation_error(r.frame.object_to_camera, scene.pose(6 + k)), 0.005);
+      EXPECT_LT(rotation_error_deg(r.frame.object_to_camera, scene.pose(6 + k)), 2.0);
+      break;
+    }
+  }
+  ASSERT_GE(back_at, 0) << "not re-acquired within 10 frames";
+  EXPECT_EQ(session.statistics().reacquisitions, 1);
+  ASSERT_EQ(session.statistics().frames_to_reacquire.size(), 1u);
+  EXPECT_GT(session.statistics().frames_to_reacquire[0], 0);
+}
+
+TEST(TrackingSession, BackwardTimeJumpRestartsFromTheRestartPose) {
+  const Scene scene;
+  TrackingSession session(scene.mesh, make_preset("klt_only"));
+  session.set_camera(scene.camera);
+  session.set_restart_pose(scene.pose(0));
+  session.initialize(scene.pose(0));
+  for (int i = 0; i < 8; ++i) session.track({scene.visible(i), 10.0 + 0.033 * i});
+  EXPECT_GT(translation_error(session.tracker().last_pose(), scene.pose(0)), 0.005);
+  EXPECT_TRUE(session.time_jumps_back(5.0));
+  EXPECT_FALSE(session.time_jumps_back(20.0));
+  // A looping bag: frame 0 again, stamped earlier.
+  const SessionResult jumped = session.track({scene.visible(0), 10.0});
+  EXPECT_TRUE(jumped.time_jumped_back);
+  EXPECT_TRUE(jumped.restarted);
+  EXPECT_EQ(jumped.frame.status, TrackStatus::kInitialized);
+  EXPECT_LT(translation_error(jumped.frame.object_to_camera, scene.pose(0)), 1e-12);
+  EXPECT_EQ(session.statistics().restarts, 1);
+  // Tracking continues from it.
+  const SessionResult next = session.track({scene.visible(1), 10.033});
+  EXPECT_EQ(next.frame.status, TrackStatus::kKeypoints);
+  EXPECT_LT(translation_error(next.frame.object_to_camera, scene.pose(1)), 0.005);
+
+  // A pose given just before the jump wins over the restart pose.
+  session.track({scene.visible(2), 10.066});
+  session.initialize(scene.pose(3));
+  const SessionResult given = session.track({scene.visible(3), 0.5});
+  EXPECT_TRUE(given.time_jumped_back);
+  EXPECT_FALSE(given.restarted);
+  EXPECT_LT(translation_error(given.frame.object_to_camera, scene.pose(3)), 1e-12);
+
+  // Without a restart pose, a jump keeps tracking.
+  session.set_restart_pose(std::nullopt);
+  const SessionResult kept = session.track({scene.visible(4), 0.1});
+  EXPECT_TRUE(kept.time_jumped_back);
+  EXPECT_FALSE(kept.restarted);
+  EXPECT_EQ(kept.frame.status, TrackStatus::kKeypoints);
+}
+
+TEST(TrackingSession, ResetWaitsForAPoseAndInvalidFramesChangeNothing) {
+  const Scene scene;
+  TrackingSession session(scene.mesh, make_preset("klt_only"));
+  EXPECT_THROW(session.initialize(scene.pose(0)), std::logic_error);
+  EXPECT_THROW(session.tracker(), std::logic_error);
+  session.set_camera(scene.camera);
+  session.initialize(scene.pose(0));
+  session.track({scene.visible(0), 0.0});
+  const SessionResult invalid = session.track({cv::Mat(10, 10, CV_8UC3), 0.1});
+  EXPECT_EQ(invalid.frame.status, TrackStatus::kInvalidInput);
+  EXPECT_FALSE(invalid.has_pose());
+  EXPECT_EQ(invalid.quality, 0.0);
+  EXPECT_EQ(session.state(), TrackState::kTracking);
+  EXPECT_EQ(session.statistics().invalid_frames, 1);
+  session.reset();
+  EXPECT_EQ(session.state(), TrackState::kWaitingForPose);
+  EXPECT_EQ(session.track({scene.visible(1), 0.2}).frame.status, TrackStatus::kNotInitialized);
+  Pose behind = scene.pose(0);
+  behind.translation().z() = -1.0;
+  EXPECT_THROW(session.initialize(behind), std::invalid_argument);
+  EXPECT_THROW(TrackingSession(std::make_shared<Mesh>(), make_preset("paper")), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace kct
