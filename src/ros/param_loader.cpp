@@ -173,8 +173,11 @@ NodeletConfig load_config(const ros::NodeHandle& nh) {
   // Only the mesh is in model units: ~initial_pose and every published pose are metres (REP 103).
   try {
     kct::ModelUnits units(config.mesh_scale);  // the core's range for a model scale
-  } catch (const std::invalid_argument& e) {
-    fail("mesh_scale", e.what());
+  } catch (const std::invalid_argument&) {
+    fail("mesh_scale", "is " + format(config.mesh_scale) + "; allowed: [" +
+                           format(kct::ModelUnits::kMinScale) + ", " +
+                           format(kct::ModelUnits::kMaxScale) +
+                           "] metres per model unit (0.001 for millimetres)");
   }
   // Optional: without it the nodelet waits for ~initial_pose (topic) or ~init (service).
   if (nh.hasParam("initial_pose/position") || nh.hasParam("initial_pose/orientation"))
