@@ -27,6 +27,15 @@ std::pair<double, int> accumulate(const std::vector<ContourSegment>& segments,
                                   const GradientImage& gradient, double spacing_px,
                                   Visitor&& visit) {
   const double x_max = gradient.width() - 2.0, y_max = gradient.height() - 2.0;
+  // Bounded work: when the projected contour is longer than kMaxSamples spacings (an absurd
+  // focal length or a pose at the camera), the spacing grows so that at most kMaxSamples points
+  // plus one per segment are visited.
+  double total_length = 0.0;
+  for (const ContourSegment& s : segments) {
+    const double length = (s.b_px - s.a_px).norm();
+    if (std::isfinite(length)) total_length += length;
+  }
+  spacing_px = std::max(spacing_px, total_length / ContourEnergy::kMaxSamples);
   double sum = 0.0;
   int count = 0;
   for (const ContourSegment& s : segments) {

@@ -1,5 +1,7 @@
 #include "klt_contour_tracker/core/mesh.h"
 
+#include "klt_contour_tracker/core/plausibility.h"
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -8,9 +10,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cctype>
 #include <cstdint>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -94,12 +98,19 @@ bool diffuse_color(const aiScene& scene, cv::Vec3b& bgr) {
 }
 
 /// Merges vertices closer than `tolerance` with a hash grid of cell size `tolerance`
-/// (27-cell neighbourhood). Returns the new index of every input vertex.
-std::vector<int> merge_by_position(const std::vector<Eigen::Vector3d>& points, double tolerance,
+/// (27-cell neighbourhood). Cells are counted from `origin` (the points' bounding-box corner),
+/// so a cell index is at most (bounding-box size / tolerance) whatever the points' offset from
+/// the object frame's origin: the float -> int64 conversion cannot overflow (the caller keeps
+/// size / tolerance at 1e6). Returns the new index of every input vertex.
+std::vector<int> merge_by_position(const std::vector<Eigen::Vector3d>& points,
+                                   const Eigen::Vector3d& origin, double tolerance,
                                    std::vector<Eigen::Vector3d>& merged) {
   struct CellHash {
     std::size_t operator()(const std::array<int64_t, 3>& c) const {
-      return static_cast<std::size_t>(c[0] * 73856093LL ^ c[1] * 19349663LL ^ c[2] * 83492791LL);
+      // Unsigned arithmetic: wraps (defined) where the signed products overflowed (UB).
+      return static_cast<std::size_t>(static_cast<uint64_t>(c[0]) * 73856093ULL ^
+                                      static_cast<uint64_t>(c[1]) * 19349663ULL ^
+                                      static_cast<uint64_t>(c[2]) * 83492791ULL);
     }
   };
   std::unordered_map<std::array<int64_t, 3>, std::vector<int>, CellHash> grid;
@@ -109,9 +120,10 @@ std::vector<int> merge_by_position(const std::vector<Eigen::Vector3d>& points, d
   const double tolerance2 = tolerance * tolerance;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d& p = points[i];
-    const std::array<int64_t, 3> cell{static_cast<int64_t>(std::floor(p.x() / tolerance)),
-                                      static_cast<int64_t>(std::floor(p.y() / tolerance)),
-                                      static_cast<int64_t>(std::floor(p.z() / tolerance))};
+    const Eigen::Vector3d q = (p - origin) / tolerance;
+    const std::array<int64_t, 3> cell{static_cast<int64_t>(std::floor(q.x())),
+                                      static_cast<int64_t>(std::floor(q.y())),
+                                      static_cast<int64_t>(std::floor(q.z()))};
     int found = -1;
     for (int dx = -1; dx <= 1 && found < 0; ++dx)
       for (int dy = -1; dy <= 1 && found < 0; ++dy)
@@ -132,6 +144,119 @@ std::vector<int> merge_by_position(const std::vector<Eigen::Vector3d>& points, d
     remap[i] = found;
   }
   return remap;
+}
+
+/// Lower-cases ASCII letters.
+std::string lower(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+/// Bytes one PLY scalar type takes in a binary file; 0 for an unknown name.
+std::uint64_t ply_type_bytes(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
+      type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+/// Checks what a file's header promises against the file's size before assimp reads it:
+/// assimp allocates what a PLY header declares (100M vertices: 1.2 GB for a 200-byte file) and
+/// what a binary STL's facet count says. Hand-written because assimp has no such pre-check.
+/// Throws std::runtime_error (via mesh_error) when the file cannot hold what its header declares.
+void check_header_against_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const std::uint64_t file_size = static_cast<std::uint64_t>(std::max<std::streamoff>(0, in.tellg()));
+  in.seekg(0);
+  char magic[5] = {0};
+  in.read(magic, 5);
+  in.clear();
+  in.seekg(0);
+  const std::string head(magic, static_cast<std::size_t>(in.gcount() > 0 ? 5 : 0));
+  std::string extension;
+  const auto dot = path.find_last_of('.');
+  if (dot != std::string::npos) extension = lower(path.substr(dot + 1));
+
+  if (head.compare(0, 3, "ply") == 0) {
+    // Header: text lines up to "end_header" (at most 64 KB).
+    bool binary = false;
+    std::uint64_t header_bytes = 0, needed = 0;
+    std::uint64_t count = 0, per_element = 0;
+    std::string line;
+    bool ended = false;
+    auto close_element = [&]() {
+      const long double total = static_cast<long double>(count) * per_element;
+      needed = total > 1e18L ? std::numeric_limits<std::uint64_t>::max()
+                             : needed + static_cast<std::uint64_t>(total);
+      count = per_element = 0;
+    };
+    while (header_bytes < 65536 && std::getline(in, line)) {
+      header_bytes += line.size() + 1;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      std::istringstream words(line);
+      std::string keyword;
+      words >> keyword;
+      if (keyword == "format") {
+        std::string format;
+        words >> format;
+        binary = format != "ascii";
+      } else if (keyword == "element") {
+        close_element();
+        std::string name, count_text;
+        words >> name >> count_text;
+        try {
+          std::size_t used = 0;
+          count = std::stoull(count_text, &used);
+          if (used != count_text.size()) throw std::invalid_argument(count_text);
+        } catch (const std::exception&) {
+          throw mesh_error(path, "PLY header: element '" + truncate_for_message(name) +
+                                     "' has an invalid count '" +
+                                     truncate_for_message(count_text) + "'");
+        }
+      } else if (keyword == "property") {
+        std::string type, count_type;
+        words >> type;
+        if (type == "list") {
+          words >> count_type;  // a list takes at least its count
+          per_element += binary ? std::max<std::uint64_t>(1, ply_type_bytes(count_type)) : 2;
+        } else {
+          per_element += binary ? std::max<std::uint64_t>(1, ply_type_bytes(type)) : 2;
+        }
+      } else if (keyword == "end_header") {
+        close_element();
+        ended = true;
+        break;
+      }
+    }
+    if (!ended) throw mesh_error(path, "PLY header: no end_header in the first 64 KB");
+    if (needed > file_size - std::min(file_size, header_bytes))
+      throw mesh_error(path, "PLY header declares elements needing at least " +
+                                 std::to_string(needed) + " bytes, but the file has " +
+                                 std::to_string(file_size) + " bytes (truncated or corrupt)");
+    return;
+  }
+  if (extension == "stl" && head != "solid") {
+    // Binary STL: 80-byte header, uint32 facet count, 50 bytes per facet.
+    if (file_size < 84)
+      throw mesh_error(path, "binary STL of " + std::to_string(file_size) +
+                                 " bytes is shorter than its 84-byte header");
+    unsigned char count_bytes[4];
+    in.seekg(80);
+    in.read(reinterpret_cast<char*>(count_bytes), 4);
+    const std::uint64_t facets = static_cast<std::uint64_t>(count_bytes[0]) |
+                                 static_cast<std::uint64_t>(count_bytes[1]) << 8 |
+                                 static_cast<std::uint64_t>(count_bytes[2]) << 16 |
+                                 static_cast<std::uint64_t>(count_bytes[3]) << 24;
+    if (facets == 0 || 84 + 50 * facets > file_size)
+      throw mesh_error(path, "binary STL declares " + std::to_string(facets) +
+                                 " facets (" + std::to_string(84 + 50 * facets) +
+                                 " bytes) but the file has " + std::to_string(file_size) +
+                                 " bytes (truncated or corrupt)");
+  }
 }
 
 double max_pairwise_distance(const std::vector<Eigen::Vector3d>& points) {
@@ -235,6 +360,7 @@ Mesh load_mesh(const std::string& path, double scale) {
   if (!(std::isfinite(scale) && scale > 0.0))
     throw mesh_error(path, "scale must be finite and > 0 (got " + std::to_string(scale) + ")");
   if (!file_exists(path)) throw mesh_error(path, "file not found or not readable");
+  check_header_against_size(path);
 
   Assimp::Importer importer;
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -274,19 +400,36 @@ Mesh load_mesh(const std::string& path, double scale) {
     lo = lo.cwiseMin(c);
     hi = hi.cwiseMax(c);
   }
+  // The bounding-box diagonal (between 1 and sqrt(3) object diameters) bounds the model's size
+  // before anything depends on it: a scale of 1e300 or a mesh in the wrong unit is named here.
   const double size = (hi - lo).norm();
   if (!(size > 0.0)) throw mesh_error(path, "all vertices coincide");
+  if (!(size >= PlausibilityLimits::kMinDiameterM && size <= PlausibilityLimits::kMaxDiameterM))
+    throw mesh_error(path, "the model is " + format_number(size) +
+                               " m across (bounding-box diagonal) after scaling by " +
+                               format_number(scale) + ": allowed [" +
+                               format_number(PlausibilityLimits::kMinDiameterM) + ", " +
+                               format_number(PlausibilityLimits::kMaxDiameterM) +
+                               "] m; is the scale right? (--model-scale / ~mesh_scale, e.g. "
+                               "0.001 for a model in millimetres)");
 
   Mesh result;
-  const std::vector<int> remap = merge_by_position(corners, 1e-6 * size, result.vertices);
+  const std::vector<int> remap = merge_by_position(corners, lo, 1e-6 * size, result.vertices);
+  // Zero-area faces (repeated or collinear corners) have no normal and no contour: dropped.
+  const double min_double_area = 1e-12 * size * size;
   for (std::size_t f = 0; f < corners.size() / 3; ++f) {
     const Eigen::Vector3i face(remap[3 * f], remap[3 * f + 1], remap[3 * f + 2]);
     if (face[0] == face[1] || face[1] == face[2] || face[0] == face[2]) continue;  // degenerate
+    const Eigen::Vector3d& a = result.vertices[face[0]];
+    if (!((result.vertices[face[1]] - a).cross(result.vertices[face[2]] - a).norm() >
+          min_double_area))
+      continue;  // collinear corners
     result.faces.push_back(face);
     if (any_uv)
       for (int k = 0; k < 3; ++k) result.corner_uvs.push_back(uvs[3 * f + k]);
   }
-  if (result.faces.empty()) throw mesh_error(path, "every triangle is degenerate");
+  if (result.faces.empty())
+    throw mesh_error(path, "every triangle is degenerate (zero area: repeated or collinear corners)");
 
   cv::Vec3b color;
   if (diffuse_color(*scene, color) && color != cv::Vec3b(0, 0, 0)) result.base_color = color;

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "klt_contour_tracker/core/plausibility.h"
 #include "klt_contour_tracker/core/pose_refiner.h"
 
 namespace kct {
@@ -28,6 +29,10 @@ Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
     : mesh_(std::move(mesh)), params_(params), keypoints_(mesh_, params) {
   if (!mesh_ || mesh_->faces.empty()) throw std::invalid_argument("Tracker: empty mesh");
   params_.validate();
+  diameter_m_ = mesh_->diameter();
+  center_object_ = mesh_->bounding_box_center();
+  const std::string size_error = implausible_diameter(diameter_m_);
+  if (!size_error.empty()) throw std::invalid_argument("Tracker: " + size_error);
   set_camera(camera);
   if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
 }
@@ -37,6 +42,8 @@ Tracker::~Tracker() = default;
 void Tracker::set_camera(const PinholeCamera& camera) {
   if (camera.width() <= 0 || camera.height() <= 0)
     throw std::invalid_argument("Tracker: camera has no image size");
+  const std::string error = implausible_camera(camera);
+  if (!error.empty()) throw std::invalid_argument("Tracker: implausible camera: " + error);
   camera_ = camera;
   // Frames are undistorted once with the same K, then everything uses the ideal pinhole.
   camera.undistortion_maps(undistort_map_x_, undistort_map_y_);
@@ -55,6 +62,8 @@ void Tracker::initialize(const Pose& object_to_camera) {
     throw std::invalid_argument("Tracker::initialize: pose is not finite or not a rotation");
   if (object_to_camera.translation().z() <= 0)
     throw std::invalid_argument("Tracker::initialize: the object is behind the camera (z <= 0)");
+  const std::string error = implausible_pose(object_to_camera, diameter_m_, center_object_, camera_);
+  if (!error.empty()) throw std::invalid_argument("Tracker::initialize: implausible pose: " + error);
   pose_i1_ = pose_i2_ = object_to_camera;
   keypoints_.clear();
   state_ = State::kPendingFirstFrame;
@@ -99,7 +108,14 @@ void Tracker::apply_refinement(const RefineResult& refined, TrackResult& result)
 std::string Tracker::check_frame(const Frame& frame) const {
   if (frame.image.empty()) return "empty image";
   if (frame.image.depth() != CV_8U || (frame.image.channels() != 1 && frame.image.channels() != 3))
-    return "image must be 8-bit grey or BGR";
+    return "image type " + cv::typeToString(frame.image.type()) +
+           " is not supported: 8-bit grey (CV_8UC1) or BGR (CV_8UC3)";
+  // Bounded work per frame: the size is checked before anything is computed on the pixels.
+  const std::string size_error =
+      implausible_image_size(static_cast<std::uint64_t>(frame.image.cols),
+                             static_cast<std::uint64_t>(frame.image.rows),
+                             static_cast<std::uint64_t>(params_.max_image_pixels));
+  if (!size_error.empty()) return size_error;
   if (frame.image.size() != camera_.size())
     return "image is " + std::to_string(frame.image.cols) + "x" + std::to_string(frame.image.rows) +
            " but the camera is " + std::to_string(camera_.width()) + "x" +

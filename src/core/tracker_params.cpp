@@ -40,6 +40,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(extrapolated_rotation_bound_deg), KCT_FIELD(extrapolated_axial_bound),
       KCT_FIELD(extrapolated_lateral_bound), KCT_FIELD(hop_rotation_deg), KCT_FIELD(hop_translation),
       KCT_FIELD(metropolis_temperature), KCT_FIELD(slsqp_max_evaluations), KCT_FIELD(random_seed),
+      KCT_FIELD(max_image_pixels),
 #undef KCT_FIELD
   };
   return table;
@@ -128,6 +129,7 @@ void TrackerParams::validate() const {
   check_range("hop_translation", hop_translation, 0.0, 10.0);
   check_range("metropolis_temperature", metropolis_temperature, 1e-9, 1e9);
   check_range("slsqp_max_evaluations", slsqp_max_evaluations, 1, 1000000);
+  check_range("max_image_pixels", max_image_pixels, 32 * 32, 16384 * 16384);
 }
 
 std::vector<std::string> preset_names() { return {"paper", "klt_only"}; }

@@ -188,3 +188,101 @@ TEST(Mesh, DiameterOfLargeMeshes) {
       exact = std::max(exact, (rod.vertices[i] - rod.vertices[j]).norm());
   EXPECT_NEAR(rod.diameter(), exact, 1e-12);
 }
+
+// ---- Bad input (issue 8, findings 4 and 5) --------------------------------------------------
+
+namespace {
+
+/// A unit cube OBJ (8 shared corners, 12 triangles) offset by `offset`, plus `extra` lines.
+void write_cube(const std::string& path, const Eigen::Vector3d& offset, const std::string& extra = "") {
+  std::ofstream obj(path);
+  obj.precision(17);
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d p =
+        offset + Eigen::Vector3d(i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 0.5 : -0.5);
+    obj << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  }
+  obj << "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\n"
+         "f 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n"
+      << extra;
+}
+
+std::string load_error(const std::string& path, double scale = 1.0) {
+  try {
+    kct::load_mesh(path, scale);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// UBSan found a signed overflow in the vertex hash (cube shifted by 1e6 m) and an overflowing
+// float -> int64 cast (larger offsets along one axis): cells are now counted from the bounding
+// box. The scripts/test.sh sanitizer pass runs this test under UBSan.
+TEST(Mesh, ModelsFarFromTheOriginMergeLikeAtTheOrigin) {
+  TempDir dir;
+  const std::string path = dir.file("far.obj");
+  write_cube(path, Eigen::Vector3d(1e6, -1e6, 1e6));
+  const kct::Mesh far = kct::load_mesh(path);
+  EXPECT_EQ(far.vertices.size(), 8u);
+  EXPECT_EQ(far.faces.size(), 12u);
+  // 1e14 m along x: the x coordinates collapse in float, the mesh flattens (not an error of
+  // ours); loading must end with a mesh or a clear error, and no undefined behaviour.
+  write_cube(path, Eigen::Vector3d(1e14, 0, 0));
+  const std::string error = load_error(path);
+  if (!error.empty()) {
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+  }
+}
+
+TEST(Mesh, ZeroAreaFacesAreDropped) {
+  TempDir dir;
+  const std::string path = dir.file("collinear.obj");
+  // Three distinct collinear vertices forming one more (zero-area) face.
+  write_cube(path, Eigen::Vector3d::Zero(), "v 2 0 0\nv 3 0 0\nv 4 0 0\nf 9 10 11\n");
+  const kct::Mesh mesh = kct::load_mesh(path);
+  EXPECT_EQ(mesh.faces.size(), 12u);
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    EXPECT_GT(mesh.face_normal(static_cast<int>(f)).norm(), 0.5);
+}
+
+TEST(Mesh, ImplausibleScalesNameTheScaleOption) {
+  TempDir dir;
+  const std::string path = dir.file("cube.obj");
+  write_cube(path, Eigen::Vector3d::Zero());
+  for (double scale : {1e300, 1e30, 1e-9}) {
+    const std::string error = load_error(path, scale);
+    EXPECT_NE(error.find("--model-scale"), std::string::npos) << scale << ": " << error;
+    EXPECT_NE(error.find("allowed [0.0001, 10000] m"), std::string::npos) << error;
+  }
+  EXPECT_EQ(load_error(path, 0.001), "");
+}
+
+TEST(Mesh, HeadersPromisingMoreThanTheFileHoldsAreRejectedBeforeLoading) {
+  TempDir dir;
+  const std::string ply = dir.file("huge.ply");
+  std::ofstream(ply) << "ply\nformat binary_little_endian 1.0\nelement vertex 100000000\n"
+                        "property float x\nproperty float y\nproperty float z\n"
+                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                     << std::string(64, '\0');
+  const std::string ply_error = load_error(ply);
+  EXPECT_NE(ply_error.find("PLY header declares"), std::string::npos) << ply_error;
+  const std::string ascii = dir.file("huge_ascii.ply");
+  std::ofstream(ascii) << "ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\n"
+                          "property float x\nend_header\n0\n";
+  EXPECT_NE(load_error(ascii).find("invalid count"), std::string::npos) << load_error(ascii);
+
+  const std::string stl = dir.file("huge.stl");
+  {
+    std::ofstream out(stl, std::ios::binary);
+    out << std::string(80, 'x');
+    const uint32_t facets = 4000000000u;
+    out.write(reinterpret_cast<const char*>(&facets), 4);
+    out << std::string(100, '\0');
+  }
+  const std::string stl_error = load_error(stl);
+  EXPECT_NE(stl_error.find("binary STL declares 4000000000 facets"), std::string::npos)
+      << stl_error;
+}

@@ -73,7 +73,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 35u);
+  EXPECT_EQ(fields.size(), 36u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

@@ -51,6 +51,11 @@ struct EnergyDetails {
 /// (no allocation per call once warm). Use one instance per thread.
 class ContourEnergy {
  public:
+  /// Bound on the points visited per evaluation: beyond kMaxSamples spacings of contour the
+  /// spacing grows to (contour length / kMaxSamples), so at most kMaxSamples + one point per
+  /// segment are sampled (ours: 640x480 contours use a few hundred points at 2 px).
+  static constexpr int kMaxSamples = 20000;
+
   /// Uses `extractor` (shared; it must not be used concurrently elsewhere).
   /// Throws std::invalid_argument for a null extractor or spacing_px <= 0.
   ContourEnergy(std::shared_ptr<const ContourExtractor> extractor, double spacing_px);

@@ -33,7 +33,7 @@ enum class TrackStatus {
   kInitialized,     ///< the frame got the pose given to initialize()
   kKeypoints,       ///< preliminary pose from KLT + PnP
   kExtrapolated,    ///< KLT failed: preliminary pose extrapolated from the two previous poses
-  kInvalidInput,    ///< empty image, wrong type or size: frame skipped, state unchanged
+  kInvalidInput,    ///< empty image, wrong type or size, more than max_image_pixels: frame skipped, state unchanged
   kReacquired,      ///< reacquire(): preliminary pose = the given pose, widened search area
 };
 const char* to_string(TrackStatus status);
@@ -56,12 +56,14 @@ struct TrackResult {
 /// Tracks one rigid object in one camera's image stream.
 class Tracker {
  public:
-  /// Throws std::invalid_argument if the parameters do not validate.
+  /// Throws std::invalid_argument if the parameters do not validate, the camera is implausible
+  /// (core/plausibility.h) or the mesh's diameter is outside [1e-4, 1e4] m.
   Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera, const TrackerParams& params);
   ~Tracker();
 
   /// The next frame passed to track() has this pose; tracking continues from it.
-  /// Throws std::invalid_argument for a non-finite pose or one with the object behind the camera.
+  /// Throws std::invalid_argument for a non-finite pose, one with the object behind the camera
+  /// or an implausible one (implausible_pose(): depth, projection; the message says why).
   void initialize(const Pose& object_to_camera);
   /// Drops the track; track() returns kNotInitialized until initialize() is called again.
   void reset();
@@ -78,7 +80,8 @@ class Tracker {
   /// Throws std::invalid_argument for an invalid `around` or search_scale < 1.
   TrackResult reacquire(const Frame& frame, const Pose& around, double search_scale);
 
-  /// Changes the intrinsics (e.g. a new camera_info); keeps the track.
+  /// Changes the intrinsics (e.g. a new camera_info); keeps the track. Throws
+  /// std::invalid_argument for an implausible camera (implausible_camera()).
   void set_camera(const PinholeCamera& camera);
   const PinholeCamera& camera() const { return camera_; }
   /// Replaces the parameters (validated; throws std::invalid_argument); keeps the track.
@@ -105,6 +108,8 @@ class Tracker {
   KeypointTracker keypoints_;
   std::unique_ptr<PoseRefiner> refiner_;
   cv::Mat undistort_map_x_, undistort_map_y_;
+  double diameter_m_ = 0.0;                         ///< mesh diameter, metres
+  Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();  ///< bounding-box centre, object frame
   State state_ = State::kWaiting;
   Pose pose_i1_ = Pose::Identity();  ///< pose of the previous frame
   Pose pose_i2_ = Pose::Identity();  ///< pose of the frame before

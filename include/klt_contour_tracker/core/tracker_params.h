@@ -63,6 +63,12 @@ struct TrackerParams {
   int slsqp_max_evaluations = 150;         ///< ours: energy evaluations per local optimization
   std::uint32_t random_seed = 1;           ///< ours: seed of the hop generator (reproducible)
 
+  // ---- Input bounds (ours) -------------------------------------------------------------------
+  /// Frames with more pixels are rejected (kInvalidInput) instead of tracked: the work per frame
+  /// grows with the pixel count (a 4000x3000 frame took over 8 s with `paper`). Default: 4K UHD
+  /// (3840x2160). Each side must also be in [32, 16384] px (core/plausibility.h).
+  int max_image_pixels = 3840 * 2160;
+
   /// Throws std::invalid_argument naming the first bad field and its allowed range.
   void validate() const;
 };
