@@ -42,7 +42,7 @@ std::vector<std::string> interface_parameter_names() {
   return {"publish_when_lost",      "energy_weight",        "min_quality",
           "energy_level_smoothing", "lost_after_bad_frames", "recover_after_good_frames",
           "reacquire_search_scale", "diagnostic_min_rate",  "diagnostic_max_rate",
-          "diagnostic_max_latency", "diagnostic_period"};
+          "diagnostic_max_latency", "diagnostic_period",   "camera_info_wait_s"};
 }
 
 InterfaceConfig load_interface_config(const ros::NodeHandle& nh) {
@@ -72,6 +72,9 @@ InterfaceConfig load_interface_config(const ros::NodeHandle& nh) {
     fail("diagnostic_max_rate", "must be greater than ~diagnostic_min_rate");
   if (!(c.diagnostic_max_latency_s > 0.0))
     fail("diagnostic_max_latency", "must be > 0 s");
+  read(nh, "camera_info_wait_s", c.camera_info_wait_s);
+  if (!(c.camera_info_wait_s >= 0.0 && c.camera_info_wait_s <= 10.0))
+    fail("camera_info_wait_s", "must be in [0, 10] s");
   return c;
 }
 
@@ -87,7 +90,8 @@ std::string describe(const InterfaceConfig& c) {
     << "  reacquire_search_scale: " << c.quality.reacquire_search_scale << "\n"
     << "  diagnostic_min_rate: " << c.diagnostic_min_rate_hz << "  # Hz\n"
     << "  diagnostic_max_rate: " << c.diagnostic_max_rate_hz << "  # Hz\n"
-    << "  diagnostic_max_latency: " << c.diagnostic_max_latency_s << "  # s\n";
+    << "  diagnostic_max_latency: " << c.diagnostic_max_latency_s << "  # s\n"
+    << "  camera_info_wait_s: " << c.camera_info_wait_s << "  # s\n";
   return s.str();
 }
 

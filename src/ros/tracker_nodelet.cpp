@@ -2,6 +2,7 @@
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <image_transport/camera_common.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <visualization_msgs/Marker.h>
 
@@ -13,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "klt_contour_tracker/core/debug_drawing.h"
+#include "klt_contour_tracker/core/plausibility.h"
 #include "klt_contour_tracker/core/pose_covariance.h"
 #include "klt_contour_tracker/ros/camera_conversion.h"
 #include "klt_contour_tracker/ros/model_loader.h"
@@ -25,6 +27,9 @@ double elapsed_ms(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
 }
+
+/// Latest image stamp accepted, s (2100-01-01T00:00:00Z; ROS 1 time ends at 2^32 s in 2106).
+constexpr std::uint32_t kLastStampSec = 4102444800u;
 
 /// A mesh URL RViz can load for ~mesh_resource, "" when there is none (URDF model or a remote
 /// resource): then the marker is a triangle list.
@@ -98,27 +103,53 @@ void TrackerNodelet::onInit() {
                                                0.1, 10),
       diagnostic_updater::TimeStampStatusParam(-1.0, interface_.diagnostic_max_latency_s));
   diagnostics_->add("tracking", this, &TrackerNodelet::diagnose);
-  diagnostic_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_->update(); });
+  diagnostic_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
+    try {
+      diagnostics_->update();
+    } catch (const std::exception& e) {
+      NODELET_ERROR_THROTTLE(5.0, "diagnostics update failed: %s", e.what());
+    }
+  });
 
   // dynamic_reconfigure: start from the loaded parameters, not the .cfg defaults.
   reconfigure_server_ =
       std::make_unique<dynamic_reconfigure::Server<TrackerConfig>>(reconfigure_mutex_, private_nh);
   reconfigure_server_->updateConfig(reconfigure_values());
-  reconfigure_server_->setCallback(
-      [this](TrackerConfig& config, uint32_t level) { on_reconfigure(config, level); });
+  reconfigure_server_->setCallback([this](TrackerConfig& config, uint32_t level) {
+    try {
+      on_reconfigure(config, level);
+    } catch (const std::exception& e) {  // nothing leaves a callback
+      NODELET_ERROR("reconfigure failed: %s", e.what());
+      try {
+        config = reconfigure_values();
+      } catch (const std::exception&) {
+      }
+    }
+  });
 
   initial_pose_sub_ =
       private_nh.subscribe("initial_pose", 1, &TrackerNodelet::on_initial_pose, this);
   init_srv_ = private_nh.advertiseService("init", &TrackerNodelet::on_init, this);
   reset_srv_ = private_nh.advertiseService("reset", &TrackerNodelet::on_reset, this);
 
+  // Image and camera_info are subscribed separately (see on_image()): an exact-time
+  // synchronizer (image_transport's CameraSubscriber) stalled for good after one lone
+  // camera_info with a future stamp.
   image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
-  camera_sub_ = image_transport_->subscribeCamera(
+  image_sub_ = image_transport_->subscribe(
       "image", static_cast<std::uint32_t>(config_.queue_size), &TrackerNodelet::on_image, this,
       image_transport::TransportHints(config_.image_transport, ros::TransportHints(), private_nh));
-  NODELET_INFO("waiting for images on %s and %s%s", camera_sub_.getTopic().c_str(),
-               camera_sub_.getInfoTopic().c_str(),
+  const std::string info_topic = image_transport::getCameraInfoTopic(image_sub_.getTopic());
+  camera_info_sub_ = nh.subscribe(info_topic, 10, &TrackerNodelet::on_camera_info, this);
+  waiting_timer_ = nh.createWallTimer(
+      ros::WallDuration(std::max(0.01, interface_.camera_info_wait_s / 2.0)),
+      [this](const ros::WallTimerEvent&) {
+        if (waiting_image_ &&
+            (ros::WallTime::now() - waiting_since_).toSec() >= interface_.camera_info_wait_s)
+          flush_waiting_image();
+      });
+  NODELET_INFO("waiting for images on %s and %s%s", image_sub_.getTopic().c_str(),
+               info_topic.c_str(),
                interface_.has_initial_pose ? "" : "; no ~initial_pose parameter: waiting for a pose on ~initial_pose or ~init");
 }
 
@@ -158,21 +189,96 @@ void TrackerNodelet::warn_skipped(const std::string& reason) {
   last_skip_log_ = now;
 }
 
-void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image,
-                              const sensor_msgs::CameraInfoConstPtr& info) {
+void TrackerNodelet::on_camera_info(const sensor_msgs::CameraInfoConstPtr& info) {
+  try {
+    camera_infos_.push_back(info);
+    while (camera_infos_.size() > 8) camera_infos_.pop_front();
+    if (waiting_image_ && waiting_image_->header.stamp == info->header.stamp) {
+      const sensor_msgs::ImageConstPtr image = waiting_image_;
+      waiting_image_.reset();
+      process_image(image, info);
+    }
+  } catch (const std::exception& e) {
+    NODELET_ERROR_THROTTLE(5.0, "camera_info callback failed: %s", e.what());
+  }
+}
+
+sensor_msgs::CameraInfoConstPtr TrackerNodelet::camera_info_for(const ros::Time& stamp) const {
+  for (auto it = camera_infos_.rbegin(); it != camera_infos_.rend(); ++it)
+    if ((*it)->header.stamp == stamp) return *it;
+  return nullptr;
+}
+
+void TrackerNodelet::flush_waiting_image() {
+  if (!waiting_image_) return;
+  const sensor_msgs::ImageConstPtr image = waiting_image_;
+  waiting_image_.reset();
+  sensor_msgs::CameraInfoConstPtr info;
+  if (!camera_infos_.empty()) {
+    info = camera_infos_.back();
+    ++frames_with_other_camera_info_;
+  }
+  process_image(image, info);
+}
+
+void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image) {
+  try {
+    const std::uint64_t dropped =
+        drops_.update(image->header.seq, image->header.stamp.toSec());
+    if (dropped > 0)
+      NODELET_WARN_THROTTLE(5.0, "%llu frame(s) lost before the tracker (header.seq / stamp "
+                                 "gap; %llu in total): the tracker is slower than the camera or "
+                                 "the queue (~queue_size) is short",
+                            static_cast<unsigned long long>(dropped),
+                            static_cast<unsigned long long>(drops_.total()));
+    last_dropped_ = dropped;
+    flush_waiting_image();  // an older image is never held behind a newer one
+    if (const sensor_msgs::CameraInfoConstPtr info = camera_info_for(image->header.stamp)) {
+      process_image(image, info);
+    } else {
+      waiting_image_ = image;
+      waiting_since_ = ros::WallTime::now();
+      if (interface_.camera_info_wait_s <= 0.0) flush_waiting_image();
+    }
+  } catch (const std::exception& e) {
+    NODELET_ERROR_THROTTLE(5.0, "image callback failed: %s", e.what());
+  }
+}
+
+void TrackerNodelet::process_image(const sensor_msgs::ImageConstPtr& image,
+                                   const sensor_msgs::CameraInfoConstPtr& info) {
   const auto start = std::chrono::steady_clock::now();
   // A status goes out for every image, also a skipped one (rosbag play --rate-control-topic
   // paces a bag on it, so a missing status would stall the player).
   auto status = boost::make_shared<TrackerStatus>();
-  status->header = image->header;
-  status->state = kct::to_string(kct::TrackStatus::kInvalidInput);
-  auto skip = [&](const std::string& reason) {
-    warn_skipped(reason);
-    status->message = reason;
-  };
   try {
+    status->header = image->header;
+    status->state = kct::to_string(kct::TrackStatus::kInvalidInput);
+    status->dropped_frames = static_cast<std::uint32_t>(std::min<std::uint64_t>(last_dropped_, 0xffffffffu));
+    status->dropped_frames_total = drops_.total();
+    last_dropped_ = 0;
+    auto skip = [&](const std::string& reason) {
+      warn_skipped(reason);
+      status->message = reason;
+    };
     std::string camera_error;
-    if (!update_camera(*info, camera_error)) {
+    // Bounded work: the size is checked before any pixel is touched (a 20000x20000 frame would
+    // cost gigabytes in the conversion alone).
+    const std::string size_error =
+        kct::implausible_image_size(image->width, image->height,
+                                    static_cast<std::uint64_t>(config_.params.max_image_pixels));
+    if (image->header.stamp.sec > kLastStampSec) {
+      // tf listeners (ours included) add their cache time to a stamp: past the end of ROS 1 time
+      // (2^32 s, year 2106) that throws inside tf2 and aborts the process.
+      skip("image stamp " + std::to_string(image->header.stamp.sec) + "." +
+           std::to_string(image->header.stamp.nsec) + " s is after 2100-01-01 (" +
+           std::to_string(kLastStampSec) + " s): tf consumers would overflow ROS time");
+    } else if (!info) {
+      ++frames_without_camera_info_;
+      skip("no camera_info received yet on " + camera_info_sub_.getTopic());
+    } else if (!size_error.empty()) {
+      skip(size_error);
+    } else if (!update_camera(*info, camera_error)) {
       skip("unusable camera_info: " + camera_error);
     } else if (static_cast<int>(image->width) != session_->tracker().camera().width() ||
                static_cast<int>(image->height) != session_->tracker().camera().height()) {
@@ -185,21 +291,27 @@ void TrackerNodelet::on_image(const sensor_msgs::ImageConstPtr& image,
   } catch (const std::exception& e) {
     // Nothing may escape a subscriber callback: it would take the whole manager down.
     NODELET_ERROR_THROTTLE(5.0, "frame %.3f failed: %s", image->header.stamp.toSec(), e.what());
-    status->message = e.what();
+    status->message = kct::truncate_for_message(e.what(), 512);
   }
-  status->tracking_state = kct::to_string(session_->state());
-  status->energy_level = session_->monitor().energy_level();
-  status->bad_frames = session_->monitor().consecutive_bad_frames();
-  status->frame_time_ms = elapsed_ms(start);
-  status_pub_.publish(status);
-  last_status_ = *status;
-  last_latency_s_ = (ros::Time::now() - image->header.stamp).toSec();
-  ++frames_;
-  diagnostics_->update();
-  NODELET_DEBUG("frame %.3f: %s / %s, quality %.2f, %d inliers, %.1f ms",
-                image->header.stamp.toSec(), status->state.c_str(),
-                status->tracking_state.c_str(), status->quality, status->klt_inliers,
-                status->frame_time_ms);
+  try {
+    status->tracking_state = kct::to_string(session_->state());
+    status->energy_level = session_->monitor().energy_level();
+    status->bad_frames = session_->monitor().consecutive_bad_frames();
+    status->frame_time_ms = elapsed_ms(start);
+    status_pub_.publish(status);
+    last_status_ = *status;
+    // In double seconds: ros::Time's operator- throws for stamps 2^31 s from now.
+    last_latency_s_ = ros::Time::now().toSec() - image->header.stamp.toSec();
+    ++frames_;
+    diagnostics_->update();
+    NODELET_DEBUG("frame %.3f: %s / %s, quality %.2f, %d inliers, %.1f ms",
+                  image->header.stamp.toSec(), status->state.c_str(),
+                  status->tracking_state.c_str(), status->quality, status->klt_inliers,
+                  status->frame_time_ms);
+  } catch (const std::exception& e) {
+    NODELET_ERROR_THROTTLE(5.0, "publishing the status of frame %.3f failed: %s",
+                           image->header.stamp.toSec(), e.what());
+  }
 }
 
 void TrackerNodelet::track(const sensor_msgs::ImageConstPtr& image, TrackerStatus& status) {
@@ -324,7 +436,12 @@ bool TrackerNodelet::queue_pose(const geometry_msgs::PoseStamped& pose, std::str
     if (camera_known || pose.header.frame_id.empty()) {
       geometry_msgs::PoseStamped latest = pose;
       latest.header.stamp = ros::Time(0);
-      to_camera_frame(latest, camera_frame_, ros::Time(0));
+      const kct::Pose object_to_camera = to_camera_frame(latest, camera_frame_, ros::Time(0));
+      if (session_->has_camera()) {
+        const std::string implausible =
+            kct::implausible_pose(object_to_camera, *mesh_, session_->tracker().camera());
+        if (!implausible.empty()) throw std::invalid_argument(implausible);
+      }
     }
     pending_pose_ = pose;
     message = "accepted: tracking starts from it on the next image";
@@ -475,6 +592,9 @@ void TrackerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& statu
   status.add("frame time (ms)", last_status_.frame_time_ms);
   status.add("latency at publication (s)", last_latency_s_);
   status.add("frames", frames_);
+  status.add("frames lost before the tracker (header.seq / stamp gaps)", drops_.total());
+  status.add("images skipped: no camera_info yet", frames_without_camera_info_);
+  status.add("images paired with a camera_info of another stamp", frames_with_other_camera_info_);
 }
 
 // ---- dynamic_reconfigure --------------------------------------------------------------------

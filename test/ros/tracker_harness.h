@@ -140,6 +140,11 @@ class Harness {
     return status;
   }
 
+  /// Publishes a camera_info alone (no image).
+  void publish_info(const sensor_msgs::CameraInfo& info) { info_pub_.publish(info); }
+  /// Publishes an image alone (its camera_info is expected from elsewhere or not at all).
+  void publish_image(const sensor_msgs::ImagePtr& image) { image_pub_.publish(image); }
+
   std::vector<klt_contour_tracker::TrackerStatus::ConstPtr> statuses() {
     std::lock_guard<std::mutex> lock(mutex_);
     return statuses_;

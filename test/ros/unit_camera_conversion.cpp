@@ -139,10 +139,10 @@ TEST(CameraFromInfo, InvalidValuesRejected) {
   expect_rejected([&] { camera_from_info(info, false); }, "D has a non-finite entry");
   info = plumb_bob();
   info.width = 0;
-  expect_rejected([&] { camera_from_info(info, true); }, "empty image size");
+  expect_rejected([&] { camera_from_info(info, true); }, "image size 0x480 px");
   info = plumb_bob();
   info.P[5] = -482;
-  expect_rejected([&] { camera_from_info(info, true); }, "P is not a valid camera");
+  expect_rejected([&] { camera_from_info(info, true); }, "P: fy = -482");
   info = plumb_bob();
   info.K[1] = 0.5;  // skew
   expect_rejected([&] { camera_from_info(info, false); }, "not a pinhole matrix");
@@ -257,6 +257,67 @@ TEST(ImageForTracker, MalformedImagesRejected) {
   image.width = 0;
   expect_rejected([&] { image_for_tracker(image); }, "empty");
   expect_rejected([] { image_for_tracker(sensor_msgs::ImageConstPtr()); }, "null");
+}
+
+// Issue 8 findings 4 and 6: implausible intrinsics and sizes are named with their value.
+TEST(CameraFromInfo, ImplausibleIntrinsicsAndSizesNamed) {
+  sensor_msgs::CameraInfo info = plumb_bob();
+  info.K[0] = 1e-300;
+  expect_rejected([&] { camera_from_info(info, false); }, "fx = 1e-300");
+  info = plumb_bob();
+  info.K[0] = 1e300;
+  expect_rejected([&] { camera_from_info(info, false); }, "fx = 1e+300");
+  info = plumb_bob();
+  info.K[2] = 1e12;
+  expect_rejected([&] { camera_from_info(info, false); }, "cx = 1e+12");
+  info = plumb_bob();
+  info.P[0] = 1e7;
+  expect_rejected([&] { camera_from_info(info, true); }, "P: fx = 1e+07");
+  for (const auto& [w, h] : std::vector<std::pair<uint32_t, uint32_t>>{
+           {1, 1}, {2, 2}, {100000, 1}, {4294967295u, 4294967295u}}) {
+    info = plumb_bob();
+    info.width = w;
+    info.height = h;
+    expect_rejected([&] { camera_from_info(info, false); },
+                    "image size " + std::to_string(w) + "x" + std::to_string(h) + " px");
+  }
+  info = plumb_bob();
+  info.binning_x = 64;  // 640 / 64 = 10 px wide
+  expect_rejected([&] { camera_from_info(info, false); }, "10x480 px");
+}
+
+TEST(ImageForTracker, Mono16WithAnOddStepIsRepacked) {
+  sensor_msgs::Image image;
+  image.encoding = enc::MONO16;
+  image.width = 2;
+  image.height = 2;
+  image.step = 5;  // 4 bytes of pixels + 1 byte of padding per row
+  const uint16_t value = 0xab00;
+  image.data.assign(10, 0);
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 2; ++c) std::memcpy(&image.data[r * 5 + 2 * c], &value, 2);
+  const cv::Mat out = image_for_tracker(image);
+  ASSERT_EQ(out.type(), CV_8UC1);
+  EXPECT_EQ(out.at<uint8_t>(1, 1), 0xab);
+}
+
+TEST(ImageForTracker, BigEndianMono16IsConverted) {
+  sensor_msgs::Image image = make_image(enc::MONO16, {0x12, 0x34});  // big-endian 0x1234
+  image.is_bigendian = 1;
+  const cv::Mat out = image_for_tracker(image);
+  ASSERT_EQ(out.type(), CV_8UC1);
+  EXPECT_EQ(out.at<uint8_t>(1, 0), 0x12);
+}
+
+TEST(ImageForTracker, LongEncodingsAreTruncatedInMessages) {
+  const std::string encoding(10000, 'e');
+  try {
+    image_for_tracker(make_image(encoding, {0}));
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_LT(std::string(e.what()).size(), 300u);
+    EXPECT_NE(std::string(e.what()).find(std::string(64, 'e') + "..."), std::string::npos);
+  }
 }
 
 }  // namespace

@@ -28,6 +28,9 @@ struct InterfaceConfig {
   double diagnostic_max_rate_hz = 1000.0;
   /// ~diagnostic_max_latency: ~pose stamp age at publication above which diagnostics warn, s.
   double diagnostic_max_latency_s = 1.0;
+  /// ~camera_info_wait_s: how long an image without a camera_info of its own stamp waits for
+  /// one before it is processed with the latest camera_info received, s (0 = never waits).
+  double camera_info_wait_s = 0.1;
 };
 
 /// Reads and validates the interface parameters. Throws ConfigError ("~name: reason").

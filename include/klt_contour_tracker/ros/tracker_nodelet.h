@@ -1,13 +1,14 @@
 #pragma once
 /// \file tracker_nodelet.h
-/// ROS wrapper of kct::TrackingSession. Subscribes `image` + `camera_info` (image_transport camera
-/// subscriber, resolved in the nodelet's namespace) and `~initial_pose`; serves `~init` and
-/// `~reset`; publishes `~pose`, `~pose_with_covariance` (object_to_camera in the image's optical
-/// frame, header = the image's header), `~status`, `~debug_image`, `~marker`, the tf image frame
-/// -> ~object_frame and /diagnostics. The session (the same core code as track_sequence and the
-/// benchmark) runs the pipeline, the WAITING_FOR_POSE / TRACKING / LOST state machine,
-/// re-acquisition while LOST and the restart on a backward time jump; the nodelet converts
-/// messages and publishes. Poses in and out are metres (REP 103), whatever ~mesh_scale.
+/// ROS wrapper of kct::TrackingSession. Subscribes `image` (image_transport) and `camera_info`
+/// (a plain subscription: the latest camera_infos are cached, see on_image()) and
+/// `~initial_pose`; serves `~init` and `~reset`; publishes `~pose`, `~pose_with_covariance`
+/// (object_to_camera in the image's optical frame, header = the image's header), `~status`,
+/// `~debug_image`, `~marker`, the tf image frame -> ~object_frame and /diagnostics. The session
+/// (the same core code as track_sequence and the benchmark) runs the pipeline, the
+/// WAITING_FOR_POSE / TRACKING / LOST state machine, re-acquisition while LOST and the restart on
+/// a backward time jump; the nodelet converts messages and publishes. Poses in and out are
+/// metres (REP 103), whatever ~mesh_scale.
 /// All work is done in callbacks on the nodelet's single-threaded callback queue.
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -25,6 +26,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <boost/thread/recursive_mutex.hpp>
+#include <deque>
 #include <memory>
 #include <optional>
 
@@ -36,6 +38,7 @@
 #include "klt_contour_tracker/core/track_quality.h"
 #include "klt_contour_tracker/core/tracker.h"
 #include "klt_contour_tracker/core/tracking_session.h"
+#include "klt_contour_tracker/ros/frame_drop_counter.h"
 #include "klt_contour_tracker/ros/interface_config.h"
 #include "klt_contour_tracker/ros/param_loader.h"
 
@@ -51,9 +54,22 @@ class TrackerNodelet : public nodelet::Nodelet {
   /// Reads the configuration and loads the model; on any error logs NODELET_FATAL and does not
   /// subscribe (the manager and its other nodelets keep running).
   void onInit() override;
-  /// One frame: camera update, conversion, tracking, publishing; a ~status for every image.
-  void on_image(const sensor_msgs::ImageConstPtr& image,
-                const sensor_msgs::CameraInfoConstPtr& info);
+  /// An image arrives. Pairing without an exact-time synchronizer (one lone or mis-stamped
+  /// message must never stop later ones): the image is processed at once with the cached
+  /// camera_info of the same stamp when there is one; otherwise it waits (one image at most)
+  /// for that camera_info until the next image arrives or ~camera_info_wait_s passes, and is
+  /// then processed with the latest camera_info received. Also counts frames dropped before it.
+  void on_image(const sensor_msgs::ImageConstPtr& image);
+  /// A camera_info arrives: cached (the last few); releases a waiting image of the same stamp.
+  void on_camera_info(const sensor_msgs::CameraInfoConstPtr& info);
+  /// Processes the waiting image, if any, with the latest camera_info.
+  void flush_waiting_image();
+  /// The cached camera_info with `stamp`, null when there is none.
+  sensor_msgs::CameraInfoConstPtr camera_info_for(const ros::Time& stamp) const;
+  /// One frame: camera update, conversion, tracking, publishing; a ~status for every image,
+  /// whatever happens (no exception leaves this function). `info` may be null (none yet).
+  void process_image(const sensor_msgs::ImageConstPtr& image,
+                     const sensor_msgs::CameraInfoConstPtr& info);
   /// Creates the session's tracker on the first usable camera_info and updates its camera when it
   /// changes. Returns false with the reason in `error` when the camera_info is unusable.
   bool update_camera(const sensor_msgs::CameraInfo& info, std::string& error);
@@ -106,10 +122,19 @@ class TrackerNodelet : public nodelet::Nodelet {
   TrackerStatus last_status_;
   double last_latency_s_ = 0.0;
   std::size_t frames_ = 0;
+  std::uint64_t last_dropped_ = 0;  ///< frames lost right before the image being processed
 
   std::unique_ptr<image_transport::ImageTransport> image_transport_;
   std::unique_ptr<image_transport::ImageTransport> private_image_transport_;
-  image_transport::CameraSubscriber camera_sub_;
+  image_transport::Subscriber image_sub_;
+  ros::Subscriber camera_info_sub_;
+  std::deque<sensor_msgs::CameraInfoConstPtr> camera_infos_;  ///< latest last, at most 8
+  sensor_msgs::ImageConstPtr waiting_image_;  ///< waits for its camera_info (see on_image())
+  ros::WallTime waiting_since_;
+  ros::WallTimer waiting_timer_;
+  FrameDropCounter drops_;  ///< frames lost before the tracker
+  std::size_t frames_without_camera_info_ = 0;  ///< images skipped: no camera_info yet
+  std::size_t frames_with_other_camera_info_ = 0;  ///< images paired with a differently stamped one
   image_transport::Publisher debug_image_pub_;
   ros::Subscriber initial_pose_sub_;
   ros::ServiceServer init_srv_, reset_srv_;
