@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cctype>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -163,6 +164,62 @@ std::uint64_t ply_type_bytes(const std::string& type) {
   return 0;
 }
 
+/// Checks the token structure of an ASCII STL (solid ... (facet normal x y z outer loop
+/// (vertex x y z){3} endloop endfacet)* endsolid, repeatable), since assimp 5's ASCII STL reader
+/// leaks the meshes it has built when it throws on a malformed file (LeakSanitizer, issue 8).
+/// Hand-written because assimp offers no validation without importing.
+void check_ascii_stl(const std::string& path, std::istream& in) {
+  std::string token;
+  std::size_t line_tokens = 0;
+  auto next = [&](std::string& out) -> bool {
+    if (!(in >> out)) return false;
+    ++line_tokens;
+    return true;
+  };
+  auto fail = [&](const std::string& what) {
+    throw mesh_error(path, "malformed ASCII STL: " + what + " (token " +
+                               std::to_string(line_tokens) + ")");
+  };
+  auto expect = [&](const char* keyword) {
+    if (!next(token) || lower(token) != keyword)
+      fail(std::string("expected '") + keyword + "', got '" + truncate_for_message(token, 32) + "'");
+  };
+  auto number = [&]() {
+    if (!next(token)) fail("missing number");
+    char* end = nullptr;
+    std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0')
+      fail("'" + truncate_for_message(token, 32) + "' is not a number");
+  };
+  bool any_facet = false;
+  while (next(token)) {
+    if (lower(token) != "solid") fail("expected 'solid', got '" + truncate_for_message(token, 32) + "'");
+    std::string name_line;
+    std::getline(in, name_line);  // the solid's name: anything up to the end of the line
+    while (true) {
+      if (!next(token)) fail("missing 'endsolid'");
+      const std::string keyword = lower(token);
+      if (keyword == "endsolid") {
+        std::getline(in, name_line);
+        break;
+      }
+      if (keyword != "facet") fail("expected 'facet' or 'endsolid', got '" + truncate_for_message(token, 32) + "'");
+      expect("normal");
+      number(), number(), number();
+      expect("outer");
+      expect("loop");
+      for (int k = 0; k < 3; ++k) {
+        expect("vertex");
+        number(), number(), number();
+      }
+      expect("endloop");
+      expect("endfacet");
+      any_facet = true;
+    }
+  }
+  if (!any_facet) fail("no facet");
+}
+
 /// Checks what a file's header promises against the file's size before assimp reads it:
 /// assimp allocates what a PLY header declares (100M vertices: 1.2 GB for a 200-byte file) and
 /// what a binary STL's facet count says. Hand-written because assimp has no such pre-check.
@@ -237,6 +294,23 @@ void check_header_against_size(const std::string& path) {
       throw mesh_error(path, "PLY header declares elements needing at least " +
                                  std::to_string(needed) + " bytes, but the file has " +
                                  std::to_string(file_size) + " bytes (truncated or corrupt)");
+    return;
+  }
+  if (extension == "stl" && head == "solid") {
+    // A binary STL may start with "solid" too: assimp takes the size match as binary.
+    if (file_size >= 84) {
+      unsigned char count_bytes[4];
+      in.seekg(80);
+      in.read(reinterpret_cast<char*>(count_bytes), 4);
+      in.clear();
+      const std::uint64_t facets = static_cast<std::uint64_t>(count_bytes[0]) |
+                                   static_cast<std::uint64_t>(count_bytes[1]) << 8 |
+                                   static_cast<std::uint64_t>(count_bytes[2]) << 16 |
+                                   static_cast<std::uint64_t>(count_bytes[3]) << 24;
+      if (84 + 50 * facets == file_size) return;
+    }
+    in.seekg(0);
+    check_ascii_stl(path, in);
     return;
   }
   if (extension == "stl" && head != "solid") {

@@ -286,3 +286,16 @@ TEST(Mesh, HeadersPromisingMoreThanTheFileHoldsAreRejectedBeforeLoading) {
   EXPECT_NE(stl_error.find("binary STL declares 4000000000 facets"), std::string::npos)
       << stl_error;
 }
+
+// assimp leaked when its ASCII STL reader threw (LeakSanitizer): malformed ASCII STL is now
+// refused before assimp sees it; a well-formed one still loads.
+TEST(Mesh, MalformedAsciiStlIsRefusedBeforeAssimp) {
+  TempDir dir;
+  const std::string good = dir.file("good.stl");
+  std::ofstream(good) << "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                         "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+  EXPECT_EQ(load_error(good), "");
+  const std::string bad = dir.file("bad.stl");
+  std::ofstream(bad) << "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0\nendsolid\n";
+  EXPECT_NE(load_error(bad).find("malformed ASCII STL"), std::string::npos) << load_error(bad);
+}
