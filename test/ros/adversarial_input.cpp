@@ -92,7 +92,9 @@ TEST(AdversarialInput, FarFutureAndZeroStampsDoNotKillTheManager) {
     EXPECT_EQ(status->header.stamp, stamp);
     // Past 2100 the frame is skipped: tf listeners (the nodelet's own one too) overflow ROS
     // time when they add their cache time to such a stamp.
-    if (stamp.sec > 4102444800u) EXPECT_NE(status->message.find("after 2100-01-01"), std::string::npos);
+    if (stamp.sec > 4102444800u) {
+      EXPECT_NE(status->message.find("after 2100-01-01"), std::string::npos) << status->message;
+    }
     ros::WallDuration(0.3).sleep();  // the abort came after the status
     ASSERT_TRUE(manager_alive()) << "manager died after the frame stamped " << stamp;
   }
@@ -137,12 +139,18 @@ TEST(AdversarialInput, FocalJumpAndAbsurdIntrinsicsAreRejectedByName) {
 // Finding 3: a huge frame is refused before it is converted (bounded memory and time).
 TEST(AdversarialInput, HugeFramesAreRefusedBeforeConversion) {
   Shared& s = shared();
-  ros::Time stamp = next_stamp();
-  sensor_msgs::CameraInfo info = s.scene.info(stamp);
-  info.width = info.height = 20000;
-  auto huge = s.frame(stamp);
-  huge->width = huge->height = 20000;  // the header claims 400 Mpx; the data is 640x480
-  expect_skipped(s.send(huge, info), "max_image_pixels");
+  ros::Time stamp;
+  sensor_msgs::CameraInfo info;
+  for (const auto& [side, part] : std::vector<std::pair<uint32_t, std::string>>{
+           {20000, "image size 20000x20000 px: each side must be in [32, 16384]"},
+           {16000, "max_image_pixels"}}) {
+    stamp = next_stamp();
+    info = s.scene.info(stamp);
+    info.width = info.height = side;
+    auto huge = s.frame(stamp);
+    huge->width = huge->height = side;  // the header claims 256-400 Mpx; the data is 640x480
+    expect_skipped(s.send(huge, info), part);
+  }
   // A real 4000x3000 frame (12 Mpx > the default 8.3 Mpx bound).
   stamp = next_stamp();
   info = s.scene.info(stamp);
