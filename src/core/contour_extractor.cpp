@@ -10,6 +10,9 @@ namespace {
 constexpr std::uint8_t kFront = 1;
 constexpr std::uint8_t kFrontVisible = 2;
 constexpr double kMinDepth = 1e-6;  // metres
+// Candidate edges are re-selected when the camera centre (object frame) moved by more than
+// this fraction of its distance to the object's centre (about 6 deg of rotation).
+constexpr double kCandidateRadiusFraction = 0.1;
 
 }  // namespace
 
@@ -117,20 +120,72 @@ std::vector<ContourSegment> ContourExtractor::extract(const Pose& object_to_came
   return segments;
 }
 
+void ContourExtractor::rebuild_candidates(const Eigen::Vector3d& camera_object) const {
+  // Within |c - c_ref| <= R every face's signed distance n . c - n . v changes by at most R
+  // (|n| = 1), so a face farther than R from the camera centre keeps its side. An edge whose
+  // two faces both keep their side is kOther for every such c when both are back-facing, or
+  // both front-facing and the edge is not sharp (Algorithm 1); only the other edges can be
+  // Contour or Sharp and are classified per call.
+  const Eigen::Vector3d center =
+      visibility_ ? visibility_->center_object() : mesh_->bounding_box_center();
+  candidate_camera_ = camera_object;
+  candidate_radius_ = kCandidateRadiusFraction * (camera_object - center).norm();
+  candidates_.clear();
+  for (std::size_t i = 0; i < edge_info_.size(); ++i) {
+    const EdgeInfo& e = edge_info_[i];
+    if (!e.usable) continue;
+    const FacePlane& p1 = face_planes_[e.face1];
+    const FacePlane& p2 = face_planes_[e.face2];
+    const double s1 = p1.normal.dot(camera_object) - p1.offset;
+    const double s2 = p2.normal.dot(camera_object) - p2.offset;
+    const bool near = std::abs(s1) <= candidate_radius_ || std::abs(s2) <= candidate_radius_;
+    const bool front1 = s1 > 0.0, front2 = s2 > 0.0;
+    if (near || front1 != front2 || (front1 && front2 && e.sharp))
+      candidates_.push_back(static_cast<int>(i));
+  }
+}
+
 void ContourExtractor::extract(const Pose& object_to_camera, const PinholeCamera& camera,
                                std::vector<ContourSegment>& segments) const {
   segments.clear();
-  classify(object_to_camera, types_scratch_);
   const Eigen::Matrix3d r = object_to_camera.linear();
   const Eigen::Vector3d t = object_to_camera.translation();
+  const Eigen::Vector3d camera_object = -(r.transpose() * t);
+  if (!(candidate_radius_ >= 0.0) || !((camera_object - candidate_camera_).norm() <= candidate_radius_))
+    rebuild_candidates(camera_object);
+  const std::uint64_t* invisible = nullptr;
+  if (visibility_) {
+    const int icosphere_face =
+        visibility_->icosphere_face(camera_object - visibility_->center_object());
+    if (icosphere_face != cached_icosphere_face_) {
+      visibility_->invisible_bits(icosphere_face, cached_invisible_);
+      cached_icosphere_face_ = icosphere_face;
+    }
+    invisible = cached_invisible_.data();
+  }
+  // Same test as compute_face_states(), for the candidates' faces only.
+  auto state = [&](int f) {
+    const FacePlane& plane = face_planes_[f];
+    const bool front = plane.normal.dot(camera_object) > plane.offset;
+    const bool hidden = invisible && ((invisible[f >> 6] >> (f & 63)) & 1u);
+    return static_cast<std::uint8_t>((front ? kFront : 0) | (front && !hidden ? kFrontVisible : 0));
+  };
   const std::vector<Eigen::Vector3d>& vertices = mesh_->vertices;
-  for (std::size_t i = 0; i < edge_info_.size(); ++i) {
-    const EdgeType type = types_scratch_[i];
+  for (const int i : candidates_) {  // ascending edge order, as a full classify()
+    const EdgeInfo& e = edge_info_[i];
+    const std::uint8_t s1 = state(e.face1), s2 = state(e.face2);
+    const bool front1 = s1 & kFront, front2 = s2 & kFront;
+    const bool visible1 = s1 & kFrontVisible, visible2 = s2 & kFrontVisible;
+    EdgeType type = EdgeType::kOther;
+    if ((visible1 && !front2) || (visible2 && !front1))
+      type = EdgeType::kContour;
+    else if (visible1 && visible2 && e.sharp)
+      type = EdgeType::kSharp;
     if (type == EdgeType::kOther) continue;
-    const Eigen::Vector3d a = r * vertices[edge_info_[i].p] + t;
-    const Eigen::Vector3d b = r * vertices[edge_info_[i].q] + t;
+    const Eigen::Vector3d a = r * vertices[e.p] + t;
+    const Eigen::Vector3d b = r * vertices[e.q] + t;
     if (a.z() <= kMinDepth || b.z() <= kMinDepth) continue;
-    segments.push_back({camera.project(a), camera.project(b), type, static_cast<int>(i)});
+    segments.push_back({camera.project(a), camera.project(b), type, i});
   }
 }
 

@@ -269,6 +269,35 @@ TEST(ContourExtractor, CachedSetFollowsTheViewpoint) {
   }
 }
 
+TEST(ContourExtractor, ExtractEqualsAFullClassificationAlongAPath) {
+  // extract() classifies only the candidate edges selected for a nearby camera centre; along
+  // a path of small and large moves (candidates reused, then re-selected) its segments must be
+  // exactly those of classify() on every edge.
+  const auto cylinder = make_cylinder(64, 0.05, 0.1);  // many near-grazing side faces
+  const auto table = VisibilityTable::build(*cylinder, 3, 128, "");
+  const ContourExtractor extractor(cylinder, table, 45.0);
+  const PinholeCamera camera(600, 600, 320, 240, 640, 480);
+  std::vector<EdgeType> types;
+  std::vector<ContourSegment> segments;
+  for (int step = 0; step < 120; ++step) {
+    // 1 deg steps around the object with a 40 deg jump every 30 steps.
+    const double azimuth = (step + 40 * (step / 30)) * M_PI / 180.0;
+    const Pose pose = look_at(0.5 * Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth),
+                                                    0.3 + 0.2 * std::sin(3 * azimuth))
+                                        .normalized());
+    extractor.extract(pose, camera, segments);
+    extractor.classify(pose, types);
+    std::vector<int> expected;
+    for (std::size_t i = 0; i < types.size(); ++i)
+      if (types[i] != EdgeType::kOther) expected.push_back(static_cast<int>(i));
+    ASSERT_EQ(segments.size(), expected.size()) << "step " << step;
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      EXPECT_EQ(segments[k].edge, expected[k]) << "step " << step;
+      EXPECT_EQ(segments[k].type, types[expected[k]]) << "step " << step;
+    }
+  }
+}
+
 TEST(ContourExtractor, RejectsBadInput) {
   const auto cube = make_cube(0.05);
   EXPECT_THROW(ContourExtractor(nullptr, nullptr, 45.0), std::invalid_argument);

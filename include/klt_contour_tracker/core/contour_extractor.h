@@ -56,6 +56,10 @@ class ContourExtractor {
 
   /// The Contour and Sharp edges projected with the ideal pinhole model; edges with an end
   /// point at camera depth z <= 1e-6 m are skipped. Segments are not clipped to the image.
+  /// Same result as classify(), faster on large meshes: one pass over all edges selects the
+  /// edges that can be Contour or Sharp while the camera centre stays within 10% of its
+  /// distance to the object (faces that cannot change side are skipped), and later calls in
+  /// that range classify only those (exact: see rebuild_candidates()).
   std::vector<ContourSegment> extract(const Pose& object_to_camera,
                                       const PinholeCamera& camera) const;
   /// Same, into `segments` (cleared first; its capacity is reused: no allocation once warm).
@@ -83,6 +87,8 @@ class ContourExtractor {
   };
   /// Fills face_state_: bit 0 front-facing, bit 1 front-facing and not in S.
   void compute_face_states(const Pose& object_to_camera) const;
+  /// Selects candidates_ for camera centres within candidate_radius_ of `camera_object`.
+  void rebuild_candidates(const Eigen::Vector3d& camera_object) const;
 
   std::shared_ptr<const Mesh> mesh_;
   std::shared_ptr<const VisibilityTable> visibility_;
@@ -94,7 +100,9 @@ class ContourExtractor {
   mutable int cached_icosphere_face_ = -1;
   mutable VisibilityTable::Bits cached_invisible_;
   mutable std::vector<std::uint8_t> face_state_;
-  mutable std::vector<EdgeType> types_scratch_;
+  mutable std::vector<int> candidates_;  ///< edge indices, ascending
+  mutable Eigen::Vector3d candidate_camera_ = Eigen::Vector3d::Zero();
+  mutable double candidate_radius_ = -1.0;  ///< < 0: no candidates selected yet
 };
 
 }  // namespace kct
