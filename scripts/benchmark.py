@@ -209,7 +209,7 @@ def main():
     ap.add_argument("--repo", required=True)
     ap.add_argument("--command", required=True, help="the command line, for the report")
     args = ap.parse_args()
-    presets = args.presets or ["paper", "klt_only"]
+    presets = args.presets or ["realtime", "paper", "klt_only"]
     repo = args.repo
     # Taken now, before anything runs: the code the binaries were built from, not whatever
     # HEAD is when the run ends (commits may land during a long run).

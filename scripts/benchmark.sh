@@ -7,7 +7,7 @@
 #   full run: can, chest, rock, bike, can_1080p x 23 sequences (60/60/60/12/40 frames):
 #             about 45 min on 2 idle cores; --frames N sets every object's sequence length,
 #             --track-frames N tracks only the first N frames (keeps the cached sequences)
-#   default presets: paper and klt_only (repeat --preset to choose)
+#   default presets: realtime, paper and klt_only (repeat --preset to choose)
 COMMAND="${KCT_WS:+KCT_WS=$KCT_WS }scripts/benchmark.sh $*"
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 ARGS=()

@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -112,10 +113,15 @@ ContourEnergy::ContourEnergy(std::shared_ptr<const Mesh> mesh,
 double ContourEnergy::evaluate(const Pose& object_to_camera, const PinholeCamera& camera,
                                const GradientImage& gradient) const {
   check_gradient(gradient);
+  const auto start = std::chrono::steady_clock::now();
   extractor_->extract(object_to_camera, camera, segments_);
+  const auto extracted = std::chrono::steady_clock::now();
   const auto [sum, count] =
       accumulate(segments_, gradient, spacing_px_,
                  [](const Eigen::Vector2d&, const Eigen::Vector2d&, double) {});
+  const auto end = std::chrono::steady_clock::now();
+  extraction_ms_ += std::chrono::duration<double, std::milli>(extracted - start).count();
+  evaluation_ms_ += std::chrono::duration<double, std::milli>(end - start).count();
   return count > 0 ? sum / count : 0.0;
 }
 

@@ -3,6 +3,7 @@
 #include "klt_contour_tracker/core/search_area.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
@@ -53,34 +54,71 @@ KeypointTracker::KeypointTracker(std::shared_ptr<const Mesh> mesh, const Tracker
 
 void KeypointTracker::clear() {
   previous_gray_.release();
+  previous_source_size_ = cv::Size();
+  previous_pyramid_.clear();
   image_points_.clear();
   object_points_.clear();
   detected_count_ = 0;
 }
 
 int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
-                            const PinholeCamera& camera) {
+                            const PinholeCamera& camera, bool same_frame_as_track) {
+  cv::Mat reused_klt_image;
+  std::vector<cv::Mat> reused_pyramid;
+  if (same_frame_as_track && previous_source_size_ == gray.size()) {
+    reused_klt_image = previous_gray_;
+    reused_pyramid = std::move(previous_pyramid_);
+  }
   clear();
+  // Large frames: corners are found (and later tracked) on the frame halved `steps` times;
+  // they are anchored and stored in full-resolution pixels.
+  const int steps = downscale_steps(gray.size());
+  const double s = std::ldexp(1.0, -steps);
+  const cv::Mat small = downscale(gray, steps);
+  const PinholeCamera small_camera =
+      steps == 0 ? camera
+                 : PinholeCamera(camera.fx() * s, camera.fy() * s, camera.cx() * s,
+                                 camera.cy() * s, small.cols, small.rows);
   RenderOptions options;
   options.draw_color = false;
-  const RenderOutput render = renderer_.render(object_to_camera, camera, options);
+  const RenderOutput render = renderer_.render(object_to_camera, small_camera, options);
   cv::Mat mask = render.mask();
   cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE,
                                                   {2 * kMaskErosionPx + 1, 2 * kMaskErosionPx + 1}));
-  previous_gray_ = klt_image(gray);
+  if (!reused_klt_image.empty()) {
+    previous_gray_ = reused_klt_image;
+    previous_pyramid_ = std::move(reused_pyramid);
+  } else {
+    previous_gray_ = klt_image(small);
+  }
+  previous_source_size_ = gray.size();
   if (cv::countNonZero(mask) == 0) return 0;
 
+  // Shi-Tomasi on the mask's bounding box plus a margin, not the whole frame: the corner
+  // response (3x3 Sobel, 3x3 block) inside the mask only sees pixels within 3 px of it, so the
+  // corners are the same as on the whole frame (same values, same row-major tie order), at the
+  // cost of the object's region only.
+  constexpr int kCornerMarginPx = 8;
+  const cv::Rect box = cv::boundingRect(mask);
+  const cv::Rect crop = cv::Rect(box.x - kCornerMarginPx, box.y - kCornerMarginPx,
+                                 box.width + 2 * kCornerMarginPx,
+                                 box.height + 2 * kCornerMarginPx) &
+                        cv::Rect(0, 0, small.cols, small.rows);
   std::vector<cv::Point2f> corners;
-  cv::goodFeaturesToTrack(gray, corners, params_.max_keypoints, params_.corner_quality_level,
-                          params_.corner_min_distance_px, mask);
+  cv::goodFeaturesToTrack(small(crop), corners, params_.max_keypoints,
+                          params_.corner_quality_level, params_.corner_min_distance_px * s,
+                          mask(crop));
 
   // Anchor each corner on the mesh: intersect its camera ray with the plane of the face the
   // face-index buffer shows there (exact on the triangle, unlike the rasterized depth).
   const Pose camera_to_object = object_to_camera.inverse();
   const Mesh& mesh = *mesh_;
-  for (const cv::Point2f& corner : corners) {
-    const int u = static_cast<int>(std::lround(corner.x));
-    const int v = static_cast<int>(std::lround(corner.y));
+  for (const cv::Point2f& corner_in_crop : corners) {
+    const cv::Point2f corner_small = corner_in_crop + cv::Point2f(crop.x, crop.y);
+    // cv::pyrDown keeps pixel centres at integer coordinates: full = small / s.
+    const cv::Point2f corner = corner_small * static_cast<float>(1.0 / s);
+    const int u = static_cast<int>(std::lround(corner_small.x));
+    const int v = static_cast<int>(std::lround(corner_small.y));
     if (u < 0 || v < 0 || u >= render.face_index.cols || v >= render.face_index.rows) continue;
     const int face = render.face_index.at<int>(v, u);
     if (face < 0) continue;
@@ -101,6 +139,20 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
   }
   detected_count_ = static_cast<int>(image_points_.size());
   return detected_count_;
+}
+
+int KeypointTracker::downscale_steps(const cv::Size& size) const {
+  int steps = 0;
+  if (params_.klt_max_image_width_px > 0)
+    for (int width = size.width; width > params_.klt_max_image_width_px && steps < 4; ++steps)
+      width = (width + 1) / 2;
+  return steps;
+}
+
+cv::Mat KeypointTracker::downscale(const cv::Mat& gray, int steps) {
+  cv::Mat small = gray;
+  for (int i = 0; i < steps; ++i) cv::pyrDown(small, small);
+  return small;
 }
 
 cv::Mat KeypointTracker::klt_image(const cv::Mat& gray) const {
@@ -128,8 +180,17 @@ bool KeypointTracker::needs_redetection() const {
 KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to_camera_guess,
                                       const PinholeCamera& camera) {
   KeypointResult result;
-  if (image_points_.empty() || previous_gray_.empty() || previous_gray_.size() != gray.size()) {
-    previous_gray_ = klt_image(gray);
+  const auto start = std::chrono::steady_clock::now();
+  auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  const int steps = downscale_steps(gray.size());
+  const double s = std::ldexp(1.0, -steps);
+  const cv::Mat small = downscale(gray, steps);
+  if (image_points_.empty() || previous_gray_.empty() || previous_source_size_ != gray.size()) {
+    previous_gray_ = klt_image(small);
+    previous_source_size_ = gray.size();
+    previous_pyramid_.clear();
     image_points_.clear();
     object_points_.clear();
     return result;
@@ -139,19 +200,30 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   // within klt_forward_backward_px of where it started.
   const cv::Size window(params_.klt_window_px, params_.klt_window_px);
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
-  std::vector<cv::Mat> previous_pyramid, current_pyramid;
-  cv::buildOpticalFlowPyramid(previous_gray_, previous_pyramid, window, params_.klt_pyramid_levels);
-  const cv::Mat current = klt_image(gray);
+  std::vector<cv::Mat> previous_pyramid = std::move(previous_pyramid_), current_pyramid;
+  previous_pyramid_.clear();
+  if (previous_pyramid.empty())
+    cv::buildOpticalFlowPyramid(previous_gray_, previous_pyramid, window,
+                                params_.klt_pyramid_levels);
+  const cv::Mat current = klt_image(small);
   cv::buildOpticalFlowPyramid(current, current_pyramid, window, params_.klt_pyramid_levels);
+  // Tracked on the (possibly halved) KLT frames; stored in full-resolution px.
+  std::vector<cv::Point2f> start_points = image_points_;
+  if (steps > 0)
+    for (cv::Point2f& p : start_points) p *= static_cast<float>(s);
   std::vector<cv::Point2f> forward, backward;
   std::vector<uchar> status_forward, status_backward;
   std::vector<float> error;
-  cv::calcOpticalFlowPyrLK(previous_pyramid, current_pyramid, image_points_, forward,
+  cv::calcOpticalFlowPyrLK(previous_pyramid, current_pyramid, start_points, forward,
                            status_forward, error, window, params_.klt_pyramid_levels, criteria);
-  backward = image_points_;
+  backward = start_points;
   cv::calcOpticalFlowPyrLK(current_pyramid, previous_pyramid, forward, backward, status_backward,
                            error, window, params_.klt_pyramid_levels, criteria,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
+  if (steps > 0) {
+    for (cv::Point2f& p : forward) p *= static_cast<float>(1.0 / s);
+    for (cv::Point2f& p : backward) p *= static_cast<float>(1.0 / s);
+  }
 
   std::vector<cv::Point2f> tracked_image;
   std::vector<cv::Point3f> tracked_object;
@@ -165,10 +237,14 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
     tracked_object.push_back(object_points_[i]);
   }
   previous_gray_ = current;
+  previous_source_size_ = gray.size();
+  previous_pyramid_ = std::move(current_pyramid);  // the next frame's previous pyramid
   image_points_ = tracked_image;
   object_points_ = tracked_object;
   result.tracked = static_cast<int>(tracked_image.size());
+  result.klt_ms = since(start);
   if (result.tracked < std::max(params_.klt_min_points, 4)) return result;
+  const auto pnp_start = std::chrono::steady_clock::now();
 
   cv::Mat rvec, tvec;
   pose_to_rvec_tvec(object_to_camera_guess, rvec, tvec);
@@ -177,7 +253,10 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
       tracked_object, tracked_image, camera.K(), cv::noArray(), rvec, tvec,
       /*useExtrinsicGuess=*/true, params_.ransac_iterations,
       static_cast<float>(params_.ransac_reprojection_px), 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
-  if (!solved || inliers.size() < 4) return result;
+  if (!solved || inliers.size() < 4) {
+    result.pnp_ms = since(pnp_start);
+    return result;
+  }
 
   std::vector<cv::Point2f> inlier_image;
   std::vector<cv::Point3f> inlier_object;
@@ -210,6 +289,7 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
     image_points_ = inlier_image;
     object_points_ = inlier_object;
   }
+  result.pnp_ms = since(pnp_start);
   return result;
 }
 

@@ -1,11 +1,15 @@
 #include "klt_contour_tracker/core/pose_refiner.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "klt_contour_tracker/core/basin_hopping.h"
+#include "klt_contour_tracker/core/coarse_to_fine_optimizer.h"
+#include "klt_contour_tracker/core/contour_cost.h"
 #include "klt_contour_tracker/core/contour_energy.h"
 #include "klt_contour_tracker/core/contour_extractor.h"
+#include "klt_contour_tracker/core/keypoint_cost.h"
 #include "klt_contour_tracker/core/pose_parametrization.h"
 #include "klt_contour_tracker/core/search_area.h"
 #include "klt_contour_tracker/core/visibility_table.h"
@@ -17,6 +21,13 @@ constexpr double kDegToRad = M_PI / 180.0;
 // Numeric-gradient steps move the projected contour by about this much, px (ours): small
 // enough to follow the optimum, large enough to see past the bilinear sampling's kinks.
 constexpr double kGradientStepPx = 0.5;
+// Huber threshold of the keypoint cue, in units of keypoint_sigma_px (ours).
+constexpr double kKeypointHuberSigmas = 2.0;
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+      .count();
+}
 
 }  // namespace
 
@@ -27,9 +38,44 @@ PoseRefiner::PoseRefiner(std::shared_ptr<const Mesh> mesh, const TrackerParams& 
                                        params_.visibility_cache_dir);
   extractor_ = std::make_shared<ContourExtractor>(mesh_, visibility_, params_.sharp_edge_angle_deg);
   energy_ = std::make_unique<ContourEnergy>(extractor_, params_.contour_sample_spacing_px);
+  size_m_ = mesh_->diameter();
+  center_object_ = mesh_->bounding_box_center();
+  for (const auto& v : mesh_->vertices) radius_m_ = std::max(radius_m_, (v - center_object_).norm());
+  build_cues();
 }
 
 PoseRefiner::~PoseRefiner() = default;
+
+void PoseRefiner::build_cues() {
+  contour_cost_ = std::make_shared<ContourCost>(extractor_, params_.contour_sample_spacing_px,
+                                                params_.blur_sigma_px, params_.num_threads);
+  keypoint_cost_ = std::make_shared<KeypointCost>(
+      params_.keypoint_sigma_px, kKeypointHuberSigmas * params_.keypoint_sigma_px);
+  costs_.clear();
+  costs_.add(contour_cost_, params_.contour_weight);
+  costs_.add(keypoint_cost_, params_.keypoint_weight);
+  for (const auto& [cue, weight] : extra_cues_) costs_.add(cue, weight);
+  prepared_gray_.release();
+}
+
+void PoseRefiner::add_cue(std::shared_ptr<PoseCost> cue, double weight) {
+  costs_.add(cue, weight);  // validates
+  extra_cues_.emplace_back(std::move(cue), weight);
+  prepared_gray_.release();
+}
+
+void PoseRefiner::prepare_frame(const cv::Mat& gray, const PinholeCamera& camera,
+                                const Pose& predicted) {
+  if (params_.optimizer != "coarse_to_fine") return;
+  const auto start = std::chrono::steady_clock::now();
+  cost_frame_ = PoseCostFrame();
+  cost_frame_.levels = make_pyramid(gray, camera, params_.pyramid_levels);
+  cost_frame_.predicted_object_to_camera = cost_frame_.preliminary_object_to_camera = predicted;
+  cost_frame_.center_object = center_object_;
+  costs_.begin_frame(cost_frame_);
+  prepared_gray_ = gray;
+  prepared_ms_ = elapsed_ms(start);
+}
 
 void PoseRefiner::set_params(const TrackerParams& params) {
   const bool rebuild_table =
@@ -46,6 +92,7 @@ void PoseRefiner::set_params(const TrackerParams& params) {
     extractor_ = std::make_shared<ContourExtractor>(mesh_, visibility_, params_.sharp_edge_angle_deg);
     energy_ = std::make_unique<ContourEnergy>(extractor_, params_.contour_sample_spacing_px);
   }
+  build_cues();
 }
 
 double PoseRefiner::energy(const cv::Mat& gray, const PinholeCamera& camera,
@@ -55,10 +102,13 @@ double PoseRefiner::energy(const cv::Mat& gray, const PinholeCamera& camera,
 
 RefineResult PoseRefiner::refine(const cv::Mat& gray, const PinholeCamera& camera,
                                  const Pose& preliminary, const KeypointResult* keypoints) {
+  if (params_.optimizer == "coarse_to_fine")
+    return refine_coarse_to_fine(gray, camera, preliminary, keypoints);
+  const auto start = std::chrono::steady_clock::now();
   RefineResult result;
   result.object_to_camera = preliminary;
-  const double size_m = mesh_->diameter();
-  const Eigen::Vector3d center_object = mesh_->bounding_box_center();
+  const double size_m = size_m_;
+  const Eigen::Vector3d center_object = center_object_;
 
   // Sec. 3.4: the search area.
   SearchArea area = make_extrapolated_search_area(size_m, params_);
@@ -107,6 +157,67 @@ RefineResult PoseRefiner::refine(const cv::Mat& gray, const PinholeCamera& camer
     result.object_to_camera = fine.best_pose;
   }
   result.energy_after = energy_->evaluate(result.object_to_camera, camera, original);
+  result.times.contour_extraction_ms = energy_->extraction_ms();
+  result.times.energy_ms = energy_->evaluation_ms() - energy_->extraction_ms();
+  energy_->reset_times();
+  result.times.optimizer_ms = std::max(
+      0.0, elapsed_ms(start) - result.times.contour_extraction_ms - result.times.energy_ms);
+  return result;
+}
+
+RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const PinholeCamera& camera,
+                                                const Pose& preliminary,
+                                                const KeypointResult* keypoints) {
+  const auto start = std::chrono::steady_clock::now();
+  if (prepared_gray_.empty() || prepared_gray_.data != gray.data ||
+      prepared_gray_.size() != gray.size())
+    prepare_frame(gray, camera, preliminary);
+  prepared_gray_.release();
+  const double image_ms = prepared_ms_;
+  const auto refine_start = std::chrono::steady_clock::now();
+
+  cost_frame_.preliminary_object_to_camera = preliminary;
+  cost_frame_.keypoints = keypoints && keypoints->success ? keypoints : nullptr;
+  CoarseToFineSettings settings;
+  settings.iterations_per_level = params_.iterations_per_level;
+  const CoarseToFineOptimizer optimizer;
+  // begin_frame() already ran in prepare_frame(): the optimizer must not repeat it.
+  const CoarseToFineResult optimized =
+      optimizer.minimize(costs_, cost_frame_, preliminary, radius_m_, settings, false);
+
+  RefineResult result;
+  result.hops = optimized.iterations;
+  result.evaluations = optimized.evaluations;
+  // Keep the refined pose only when it lowers the whole objective on the finest level (both
+  // poses scored with the contour extracted at the refined pose) and, with keypoints, stays
+  // inside the paper's keypoint search area (Sec. 3.4: the inliers' mean reprojection error
+  // grows by at most max_reprojection_increase_px), here a test on the result rather than a
+  // constraint on the search.
+  result.accepted = optimized.final_cost < optimized.initial_cost;
+  if (result.accepted && keypoint_cost_->active() &&
+      keypoint_cost_->mean_error_px(optimized.object_to_camera) >
+          keypoint_cost_->mean_error_px(preliminary) + params_.max_reprojection_increase_px)
+    result.accepted = false;
+  result.object_to_camera = result.accepted ? optimized.object_to_camera : preliminary;
+  result.energy_after = contour_cost_->energy(result.object_to_camera);
+  contour_cost_->linearize(preliminary, 0);
+  result.energy_before = contour_cost_->energy(preliminary);
+
+  // Stage times: the contour cue's linearizations are the contour extraction, all evaluations
+  // the energy; the rest of the refinement is the optimizer's own work.
+  result.times.image_ms = image_ms;
+  for (std::size_t i = 0; i < costs_.terms().size(); ++i) {
+    const auto& t = costs_.times()[i];
+    if (costs_.terms()[i].first == contour_cost_)
+      result.times.contour_extraction_ms += t.linearize_ms;
+    else
+      result.times.energy_ms += t.linearize_ms;
+    result.times.energy_ms += t.evaluate_ms;
+  }
+  result.times.optimizer_ms =
+      std::max(0.0, elapsed_ms(refine_start) - result.times.contour_extraction_ms -
+                        result.times.energy_ms);
+  (void)start;
   return result;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -103,6 +104,21 @@ void Tracker::apply_refinement(const RefineResult& refined, TrackResult& result)
   result.energy_before = refined.energy_before;
   result.energy_after = refined.energy_after;
   result.hops = refined.hops;
+  result.times.image_ms = refined.times.image_ms;
+  result.times.contour_extraction_ms = refined.times.contour_extraction_ms;
+  result.times.energy_ms = refined.times.energy_ms;
+  result.times.optimizer_ms = refined.times.optimizer_ms;
+}
+
+double Tracker::detect_keypoints(const cv::Mat& gray, TrackResult& result,
+                                 bool same_frame_as_track) {
+  const auto start = std::chrono::steady_clock::now();
+  keypoints_.detect(gray, pose_i1_, camera_, same_frame_as_track);
+  frames_since_detection_ = 0;
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.times.keypoint_detection_ms += ms;
+  return ms;
 }
 
 std::string Tracker::check_frame(const Frame& frame) const {
@@ -156,8 +172,7 @@ TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double se
     }
     pose_i1_ = pose_i2_ = result.object_to_camera;
     keypoints_.clear();
-    keypoints_.detect(gray, pose_i1_, camera_);
-    frames_since_detection_ = 0;
+    detect_keypoints(gray, result);
     state_ = State::kTracking;
   }
   result.frame_time_ms =
@@ -185,16 +200,29 @@ TrackResult Tracker::track(const Frame& frame) {
   const cv::Mat gray = to_gray(frame.image);
 
   if (state_ == State::kPendingFirstFrame) {
-    keypoints_.detect(gray, pose_i1_, camera_);
-    frames_since_detection_ = 0;
+    detect_keypoints(gray, result);
     state_ = State::kTracking;
     result.status = TrackStatus::kInitialized;
     result.object_to_camera = result.preliminary_object_to_camera = pose_i1_;
     return finish();
   }
 
+  // The refinement's image work (pyramid, image derivatives) needs only the frame and the
+  // previous pose: with a second thread it runs while KLT does. The same call is made either
+  // way, so the result does not depend on num_threads.
+  const bool prepare = params_.refine && refiner_ && params_.optimizer == "coarse_to_fine";
+  std::future<void> prepared;
+  if (prepare && params_.num_threads >= 2)
+    prepared = std::async(std::launch::async,
+                          [&]() { refiner_->prepare_frame(gray, camera_, pose_i1_); });
+  else if (prepare)
+    refiner_->prepare_frame(gray, camera_, pose_i1_);
+
   // Sec. 3.1: preliminary pose from KLT + PnP, or extrapolated when KLT fails.
   result.keypoints = keypoints_.track(gray, pose_i1_, camera_);
+  if (prepared.valid()) prepared.get();  // rethrows the preparation's exception, if any
+  result.times.klt_ms = result.keypoints.klt_ms;
+  result.times.pnp_ms = result.keypoints.pnp_ms;
   if (result.keypoints.success) {
     result.status = TrackStatus::kKeypoints;
     result.preliminary_object_to_camera = result.keypoints.object_to_camera;
@@ -225,8 +253,7 @@ TrackResult Tracker::track(const Frame& frame) {
        (!result.refined ||
         refined_pose_agrees_with_keypoints(result.keypoints, result.object_to_camera, camera_,
                                            params_.redetect_max_reprojection_increase_px)))) {
-    keypoints_.detect(gray, pose_i1_, camera_);
-    frames_since_detection_ = 0;
+    detect_keypoints(gray, result, /*same_frame_as_track=*/true);
   }
   return finish();
 }

@@ -73,8 +73,25 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 36u);
+  EXPECT_EQ(fields.size(), 44u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
+}
+
+TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
+  const TrackerParams realtime = make_preset("realtime");
+  EXPECT_NO_THROW(realtime.validate());
+  EXPECT_EQ(realtime.optimizer, "coarse_to_fine");
+  EXPECT_GE(realtime.num_threads, 2);
+  EXPECT_EQ(preset_names().front(), "realtime");
+  // `paper` stays the struct's defaults, with the paper's optimizer.
+  EXPECT_EQ(describe(make_preset("paper")), describe(TrackerParams{}));
+  EXPECT_EQ(make_preset("paper").optimizer, "basin_hopping");
+  TrackerParams bad = realtime;
+  bad.optimizer = "gradient_descent";
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.num_threads = 0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
 }  // namespace

@@ -75,10 +75,17 @@ class ContourEnergy {
   const ContourExtractor& extractor() const { return *extractor_; }
   double spacing_px() const { return spacing_px_; }
 
+  /// Wall time spent in evaluate() / evaluate_details() since the last reset_times(), and the
+  /// part of it spent extracting the contour, ms (for the stage table).
+  double evaluation_ms() const { return evaluation_ms_; }
+  double extraction_ms() const { return extraction_ms_; }
+  void reset_times() { evaluation_ms_ = extraction_ms_ = 0.0; }
+
  private:
   std::shared_ptr<const ContourExtractor> extractor_;
   double spacing_px_;
   mutable std::vector<ContourSegment> segments_;
+  mutable double evaluation_ms_ = 0.0, extraction_ms_ = 0.0;
 };
 
 }  // namespace kct

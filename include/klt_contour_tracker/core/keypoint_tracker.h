@@ -32,6 +32,8 @@ struct KeypointResult {
   double inlier_ratio = 0.0;     ///< inliers / tracked
   double mean_reprojection_px = 0.0;  ///< mean reprojection error of the inliers at the PnP pose
   KeypointInliers inlier_points;      ///< correspondences used by the search area
+  double klt_ms = 0.0;  ///< wall time of the KLT tracking (normalization, pyramids, LK), ms
+  double pnp_ms = 0.0;  ///< wall time of PnP + RANSAC + LM, ms
 };
 
 /// True when `refined` keeps the KLT inliers' mean reprojection error within
@@ -48,7 +50,10 @@ class KeypointTracker {
 
   /// Detects corners in `gray` (CV_8UC1) inside the object's projection at `object_to_camera`
   /// and anchors them on the mesh. Returns the number of anchored keypoints.
-  int detect(const cv::Mat& gray, const Pose& object_to_camera, const PinholeCamera& camera);
+  /// `same_frame_as_track`: `gray` is the frame the last track() call got (the tracker
+  /// re-detects on the frame it just tracked): its KLT image and pyramid are reused.
+  int detect(const cv::Mat& gray, const Pose& object_to_camera, const PinholeCamera& camera,
+             bool same_frame_as_track = false);
 
   /// Tracks the anchored keypoints from the previous frame into `gray` and solves PnP from
   /// `object_to_camera_guess` (used as the RANSAC initial guess). Keeps the inliers.
@@ -67,11 +72,18 @@ class KeypointTracker {
   /// The frame KLT tracks on: `gray` normalized to zero mean / unit variance over
   /// klt_illumination_window_px windows (or a copy of `gray` when the window is 0).
   cv::Mat klt_image(const cv::Mat& gray) const;
+  /// How often a frame of `size` is halved for KLT and corners (klt_max_image_width_px).
+  int downscale_steps(const cv::Size& size) const;
+  /// `gray` halved `steps` times with cv::pyrDown (pixel u there is 2^steps u here).
+  static cv::Mat downscale(const cv::Mat& gray, int steps);
 
   std::shared_ptr<const Mesh> mesh_;
   Renderer renderer_;
   TrackerParams params_;
-  cv::Mat previous_gray_;
+  cv::Mat previous_gray_;          ///< KLT image of the previous frame (possibly halved)
+  cv::Size previous_source_size_;  ///< full-resolution size of that frame
+  /// cv::buildOpticalFlowPyramid of previous_gray_ (empty until a track() built it).
+  std::vector<cv::Mat> previous_pyramid_;
   std::vector<cv::Point2f> image_points_;
   std::vector<cv::Point3f> object_points_;
   int detected_count_ = 0;

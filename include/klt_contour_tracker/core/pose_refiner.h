@@ -1,8 +1,10 @@
 #pragma once
 /// \file pose_refiner.h
-/// Contour-energy refinement of a preliminary pose (paper Sec. 3.2-3.4 and supplement):
-/// Basin-Hopping + SLSQP on the blurred frame inside the search area, then a short final
-/// run on the original frame.
+/// Contour-energy refinement of a preliminary pose. optimizer = "basin_hopping" (paper Sec.
+/// 3.2-3.4 and supplement): Basin-Hopping + SLSQP on the blurred frame inside the search area,
+/// then a short final run on the original frame. optimizer = "coarse_to_fine" (ours, the
+/// `realtime` preset): Levenberg-Marquardt over an image pyramid on a weighted sum of cues
+/// (pose_cost.h): the contour energy with an analytic gradient and the keypoint reprojection.
 
 #include <memory>
 #include <opencv2/core.hpp>
@@ -11,6 +13,8 @@
 #include "klt_contour_tracker/core/keypoint_tracker.h"
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/pose_cost.h"
+#include "klt_contour_tracker/core/stage_times.h"
 #include "klt_contour_tracker/core/tracker_params.h"
 
 namespace kct {
@@ -18,14 +22,21 @@ namespace kct {
 class VisibilityTable;
 class ContourExtractor;
 class ContourEnergy;
+class ContourCost;
+class KeypointCost;
 
 /// Outcome of one refinement.
 struct RefineResult {
   Pose object_to_camera = Pose::Identity();  ///< refined pose
   double energy_before = 0.0;  ///< Eq. 5 at the preliminary pose, unblurred frame
   double energy_after = 0.0;   ///< Eq. 5 at the refined pose, unblurred frame
-  int hops = 0;                ///< hops of both stages
+  int hops = 0;                ///< hops of both stages (coarse_to_fine: linearizations)
   int evaluations = 0;         ///< energy evaluations of both stages
+  /// coarse_to_fine: false when the refined pose did not lower the objective and the
+  /// preliminary pose was kept (always true for basin_hopping).
+  bool accepted = true;
+  /// Stage times of the refinement (image, contour extraction, energy, optimizer), ms.
+  StageTimes times;
 };
 
 /// Refines poses of one mesh; owns the visibility table, contour extractor and energy.
@@ -38,8 +49,19 @@ class PoseRefiner {
   /// Refines `preliminary` on `gray` (CV_8UC1). `keypoints` holds the KLT inliers when the
   /// preliminary pose came from PnP (search area = reprojection constraint, Sec. 3.4), or is
   /// null when it was extrapolated (search area = Euler/translation box).
+  /// With optimizer = coarse_to_fine, energy_before/after are Eq. 5 on the full-resolution
+  /// level blurred by blur_sigma_px.
   RefineResult refine(const cv::Mat& gray, const PinholeCamera& camera, const Pose& preliminary,
                       const KeypointResult* keypoints);
+
+  /// coarse_to_fine only (a no-op otherwise): the frame's image work (pyramid, image
+  /// derivatives, each cue's begin_frame) for `gray` (CV_8UC1, the frame refine() will get),
+  /// with the object expected near `predicted` (e.g. the previous pose). The tracker calls it
+  /// on a second thread while KLT runs; refine() does it itself when it was not called.
+  void prepare_frame(const cv::Mat& gray, const PinholeCamera& camera, const Pose& predicted);
+
+  /// Adds a cue to the coarse_to_fine objective (e.g. a region or colour cue) with `weight`.
+  void add_cue(std::shared_ptr<PoseCost> cue, double weight);
 
   /// Contour energy (Eq. 5) of a pose on an unblurred frame, for diagnostics.
   double energy(const cv::Mat& gray, const PinholeCamera& camera, const Pose& object_to_camera) const;
@@ -54,6 +76,20 @@ class PoseRefiner {
   std::shared_ptr<const ContourExtractor> extractor_;
   std::unique_ptr<ContourEnergy> energy_;
   std::uint32_t frame_counter_ = 0;
+  double size_m_ = 0.0;   ///< mesh diameter (costly to compute on large meshes: cached)
+  double radius_m_ = 0.0; ///< largest distance of a vertex from the bounding-box centre
+  Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();
+
+  RefineResult refine_coarse_to_fine(const cv::Mat& gray, const PinholeCamera& camera,
+                                     const Pose& preliminary, const KeypointResult* keypoints);
+  void build_cues();
+  PoseCostFrame cost_frame_;
+  PoseCostSum costs_;
+  std::shared_ptr<ContourCost> contour_cost_;
+  std::shared_ptr<KeypointCost> keypoint_cost_;
+  std::vector<std::pair<std::shared_ptr<PoseCost>, double>> extra_cues_;
+  cv::Mat prepared_gray_;  ///< the frame prepare_frame() prepared (held: its buffer stays unique)
+  double prepared_ms_ = 0.0;
 };
 
 }  // namespace kct

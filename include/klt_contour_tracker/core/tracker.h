@@ -12,6 +12,7 @@
 #include "klt_contour_tracker/core/keypoint_tracker.h"
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/stage_times.h"
 #include "klt_contour_tracker/core/tracker_params.h"
 
 namespace kct {
@@ -50,6 +51,7 @@ struct TrackResult {
   double energy_after = 0.0;      ///< contour energy at the final pose, frame unblurred
   int hops = 0;                   ///< basin-hopping hops run (all stages)
   double frame_time_ms = 0.0;     ///< wall time spent in track()
+  StageTimes times;               ///< where frame_time_ms went, per stage
   std::string message;            ///< human-readable detail for kInvalidInput
 };
 
@@ -99,6 +101,10 @@ class Tracker {
   /// Copies a refinement's pose (when valid) and statistics into `result`.
   static void apply_refinement(const RefineResult& refined, TrackResult& result);
   cv::Mat to_gray(const cv::Mat& image) const;
+  /// Re-detects keypoints at pose_i1_, adds the time to result.times; returns it, ms.
+  /// `same_frame_as_track`: `gray` went through keypoints_.track() in this call.
+  double detect_keypoints(const cv::Mat& gray, TrackResult& result,
+                          bool same_frame_as_track = false);
   /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
   std::string check_frame(const Frame& frame) const;
 

@@ -23,6 +23,10 @@ struct TrackerParams {
   /// side, px (0 = raw frames), so that a light switched on or moved (OPT's flash and moving
   /// light groups) does not break the brightness-constancy assumption of Lucas-Kanade.
   int klt_illumination_window_px = 15;
+  /// ours: frames wider than this are halved (repeatedly, at most 4 times) for KLT and corner
+  /// detection; keypoints stay in full-resolution pixels (0 = never; `realtime`: 1000, so a
+  /// 1920x1080 frame is tracked at 960x540).
+  int klt_max_image_width_px = 0;
   double ransac_reprojection_px = 3.0;     ///< ours: RANSAC inlier threshold, px
   int ransac_iterations = 200;             ///< ours: RANSAC iterations
   int klt_min_points = 8;                  ///< paper: KLT fails below this many tracked points
@@ -69,6 +73,23 @@ struct TrackerParams {
   /// (3840x2160). Each side must also be in [32, 16384] px (core/plausibility.h).
   int max_image_pixels = 3840 * 2160;
 
+  // ---- Coarse-to-fine refinement (ours; the `realtime` preset) ------------------------------
+  /// "basin_hopping": the paper's Basin-Hopping + SLSQP on Eq. 5 (Sec. 3.3). "coarse_to_fine":
+  /// Levenberg-Marquardt on a weighted sum of cues (pose_cost.h: the contour energy with an
+  /// analytic gradient, the keypoint reprojection) over an image pyramid, coarsest first.
+  std::string optimizer = "basin_hopping";
+  int pyramid_levels = 3;                  ///< ours: coarse_to_fine levels, 1 = full resolution
+  int iterations_per_level = 4;            ///< ours: coarse_to_fine linearizations per level
+  double contour_weight = 1.0;             ///< ours: coarse_to_fine weight of the contour cue
+  /// ours: coarse_to_fine weight of the keypoint cue. Weak on purpose: the contour cue must be
+  /// able to correct KLT drift (measured on the benchmark: 0.1 beats 1 and 0.03), while the
+  /// refined pose is rejected when it leaves the keypoint search area (E_max above).
+  double keypoint_weight = 0.1;
+  double keypoint_sigma_px = 2.0;          ///< ours: expected keypoint error (cue scale), px
+  /// ours: threads the tracker may use (KLT overlapped with the refinement's image work,
+  /// pyramid levels in parallel); results do not depend on it.
+  int num_threads = 1;
+
   /// Throws std::invalid_argument naming the first bad field and its allowed range.
   void validate() const;
 };
@@ -84,7 +105,9 @@ std::vector<std::pair<std::string, std::string>> describe(const TrackerParams& p
 /// Names accepted by make_preset().
 std::vector<std::string> preset_names();
 
-/// "paper": the paper's values (the defaults). "klt_only": keypoints only, no refinement; it
+/// "realtime" (the default of the nodelet, track_sequence and the benchmark): keypoints as
+/// `paper`, refinement by the coarse_to_fine optimizer on two threads (camera rate; see
+/// docs/benchmarks.md). "paper": the paper's values (the defaults). "klt_only": keypoints only, no refinement; it
 /// re-detects only when the tracks thin out, since re-anchoring every frame on unrefined poses
 /// accumulates drift (the strongest keypoint-only baseline, measured in docs/benchmarks.md).
 /// Throws std::invalid_argument for an unknown name, listing the known ones.

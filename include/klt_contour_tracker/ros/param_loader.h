@@ -32,7 +32,7 @@ struct NodeletConfig {
   /// unset: interface_config.h's has_initial_pose says whether it was given).
   kct::Pose initial_pose = kct::Pose::Identity();
   std::string object_frame = "object";  ///< ~object_frame: child frame of the published tf
-  std::string preset = "paper";        ///< ~preset: kct::make_preset() name
+  std::string preset = "realtime";     ///< ~preset: kct::make_preset() name
   int queue_size = 1;                  ///< ~queue_size: image/camera_info subscriber queue
   std::string image_transport = "raw";  ///< ~image_transport: image_transport plugin name
   kct::TrackerParams params;           ///< preset + ~<field> overrides, validated
