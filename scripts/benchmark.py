@@ -6,6 +6,8 @@ and writes docs/benchmarks.md with the AUC tables (like the paper's Tables 1-3),
 times and PNG success curves in docs/benchmarks/. Python standard library only.
 """
 import argparse
+import shutil
+import tempfile
 import datetime
 import json
 import os
@@ -108,6 +110,30 @@ def track(data, results, obj, group, speed, preset, max_frames, repo):
     log("%-9s %-10s %-14s AUC %5.2f  median %7.1f ms" % (preset, obj, seq_name(group, speed),
                                                          summary["auc"], summary["median_ms"]))
     return summary
+
+
+def startup_times(data, obj, preset, tmp):
+    """Wall time of a 2-frame track_sequence run (mesh load, visibility table, first frames) with
+    an empty visibility cache, then again with the cache it wrote: (first, cached) seconds."""
+    spec = OBJECTS[obj]
+    folder = ensure_sequence(data, obj, *all_sequences()[0])
+    cache = tempfile.mkdtemp(prefix="kct_startup_", dir=tmp)
+    times = []
+    for _ in range(2):
+        cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder,
+               "--model", os.path.join(data, "models", spec["model"] + ".obj"), "--preset", preset,
+               "--param", "visibility_cache_dir=" + cache, "--max-frames", "2", "--quiet"]
+        t0 = time.time()
+        proc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        times.append(time.time() - t0 if proc.returncode == 0 else None)
+    shutil.rmtree(cache, ignore_errors=True)
+    log("startup   %-10s %-9s first %s s, cached %s s" % (obj, preset, fmt(times[0], 1), fmt(times[1], 1)))
+    return times
+
+
+STAGES = [("klt", "KLT"), ("pnp", "PnP"), ("keypoint_detection", "keypoint detection"),
+          ("image", "image (pyramid, gradients)"), ("contour_extraction", "contour extraction"),
+          ("energy", "energy (cues)"), ("optimizer", "optimizer")]
 
 
 def weighted_auc(rows):
@@ -251,8 +277,21 @@ def main():
                 if r:
                     r["preset"] = preset
                     rows.append(r)
+    # Start-up of the default preset per model: first start (visibility table built) and cached.
+    startup = {}
+    if "realtime" in presets:
+        for obj in objects:
+            startup[obj] = startup_times(data, obj, "realtime", tmp)
     total_s = time.time() - t0
     load_end = os.getloadavg()
+
+    def growth(p):
+        vga = [(r0["faces"], median([r["median_ms"] for r in sel(preset=p, object=o)]))
+               for o in objects for r0 in sel(preset=p, object=o)[:1] if r0["width"] == 640]
+        if len(vga) < 2:
+            return "-"
+        small, large = min(vga), max(vga)
+        return "%.1fx (%d to %d faces)" % (large[1] / small[1], small[0], large[0]) if small[1] else "-"
 
     def sel(**kw):
         return [r for r in rows if all(
@@ -377,6 +416,36 @@ def main():
         L.append("| %s | %d | %dx%d | %s |" % (o, r0[0]["faces"], r0[0]["width"], r0[0]["height"],
                  " | ".join(fmt(median([r["median_ms"] for r in sel(preset=p, object=o)]), 1) for p in presets)))
     L.append("")
+
+    L.append("Growth from the smallest to the largest mesh at 640x480 (the paper: 2.4x): " + ", ".join(
+        "%s %s" % (p, growth(p)) for p in presets) + ".\n")
+
+    staged = [p for p in presets if any("stage_median_ms" in r for r in sel(preset=p))]
+    if staged:
+        L.append("### Where the time goes\n")
+        L.append("Median over the sequences of each stage's median time per frame, ms. With 2 threads the "
+                 "refinement's image work runs while KLT does, so the stages may add up to more than "
+                 "the frame time.\n")
+        L.append("| preset | object | frame | " + " | ".join(t for _, t in STAGES) + " |")
+        L.append("|---|---|---|" + "---|" * len(STAGES))
+        for p in staged:
+            for o in objects:
+                rr = [r for r in sel(preset=p, object=o) if "stage_median_ms" in r]
+                if rr:
+                    L.append("| %s | %s | %s | %s |" % (p, o, fmt(median([r["median_ms"] for r in rr]), 1), " | ".join(
+                        fmt(median([r["stage_median_ms"].get(k, 0.0) for r in rr]), 1) for k, _ in STAGES)))
+        L.append("")
+    if startup:
+        L.append("### Start-up (realtime)\n")
+        L.append("Wall time of a 2-frame `track_sequence` run: mesh load, visibility table, first frames; "
+                 "first with an empty visibility cache, then with the table it cached, s.\n")
+        L.append("| object | faces | first start | cached |")
+        L.append("|---|---|---|---|")
+        for o in objects:
+            r0 = sel(object=o)
+            L.append("| %s | %s | %s | %s |" % (o, r0[0]["faces"] if r0 else "-", fmt(startup[o][0], 1),
+                                              fmt(startup[o][1], 1)))
+        L.append("")
 
     L.append("## Other metrics\n")
     L.append("| preset | object | success 5 cm / 5 deg | mean ADD, mm | extrapolated frames |")
