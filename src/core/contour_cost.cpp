@@ -12,6 +12,7 @@ namespace {
 
 constexpr double kMinDepth = 1e-6;  // metres, as the extractor
 constexpr double kContrastFactor = 8.0;
+constexpr double kReextractFraction = 0.01;
 
 /// Bilinear interpolation of a CV_32F image at (x0 + fx, y0 + fy); 0 <= x0 < cols - 1 and
 /// 0 <= y0 < rows - 1 guaranteed by the caller.
@@ -77,6 +78,7 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
   segments_.clear();
   samples_.clear();
   level_ = 0;
+  extracted_ = false;
 
   // Region around the object's projection at the preliminary pose (full-resolution px): the
   // bounding sphere of the mesh, plus its projected radius and 32 px on every side.
@@ -145,21 +147,54 @@ void ContourCost::linearize(const Pose& object_to_camera, int level) {
   samples_.clear();
   if (levels_[level].roi.empty()) return;
   const PinholeCamera& camera = frame_->levels[level].camera;
-  extractor_->extract(object_to_camera, camera, scratch_);
   const std::vector<MeshEdge>& edges = extractor_->edges();
   const std::vector<Eigen::Vector3d>& vertices = extractor_->mesh().vertices;
+  // The edge set (Algorithm 1) is extracted again only when the camera centre, in the object
+  // frame, moved by more than kReextractFraction of its distance to the object since the last
+  // extraction of this frame (about 0.6 deg): between the optimizer's small steps and from one
+  // pyramid level to the next the same edges are re-projected and re-sampled.
+  const Eigen::Vector3d camera_object =
+      -(object_to_camera.linear().transpose() * object_to_camera.translation());
+  const double distance = (camera_object - frame_->center_object).norm();
+  if (!extracted_ || !((camera_object - extracted_camera_).norm() <= kReextractFraction * distance)) {
+    extractor_->extract(object_to_camera, camera, scratch_);
+    extracted_camera_ = camera_object;
+    extracted_ = true;
+  } else {
+    // Re-project the kept edges for this pose and level (as extract() does).
+    const Eigen::Matrix3d r = object_to_camera.linear();
+    const Eigen::Vector3d t = object_to_camera.translation();
+    for (ContourSegment& s : scratch_) {
+      const Eigen::Vector3d a = r * vertices[edges[s.edge].v0] + t;
+      const Eigen::Vector3d b = r * vertices[edges[s.edge].v1] + t;
+      const bool in_front = a.z() > kMinDepth && b.z() > kMinDepth;
+      s.a_px = in_front ? camera.project(a) : Eigen::Vector2d::Zero();
+      s.b_px = in_front ? camera.project(b) : Eigen::Vector2d::Zero();  // length 0: skipped
+    }
+  }
+  // Points every `step` px along the projected edges taken one after the other (the remainder
+  // carried from edge to edge, so that a fine mesh's many short edges are not each given a
+  // point of their own), at most kMaxSamples of them: the cost stops growing with the mesh.
+  double total_length = 0.0;
+  for (const ContourSegment& s : scratch_) {
+    const double length = (s.b_px - s.a_px).norm();
+    if (length > 1e-9 && std::isfinite(length)) total_length += length;
+  }
+  if (!(total_length > 0.0)) return;
+  const double step = std::max(spacing_px_, total_length / kMaxSamples);
+  double next = 0.5 * step;  // distance from the current edge's start to the next point
   for (const ContourSegment& s : scratch_) {
     const double length = (s.b_px - s.a_px).norm();
     if (!(length > 1e-9) || !std::isfinite(length)) continue;
-    const int n = std::max(1, static_cast<int>(std::lround(length / spacing_px_)));
     Segment segment;
     segment.a_object = vertices[edges[s.edge].v0];
     segment.b_object = vertices[edges[s.edge].v1];
     segment.first_sample = static_cast<int>(samples_.size());
-    for (int k = 0; k < n; ++k)
-      samples_.push_back(segment.a_object + ((k + 0.5) / n) * (segment.b_object - segment.a_object));
+    for (; next < length; next += step)
+      samples_.push_back(segment.a_object + (next / length) * (segment.b_object - segment.a_object));
+    next -= length;
     segment.end_sample = static_cast<int>(samples_.size());
-    segments_.push_back(segment);
+    if (segment.end_sample > segment.first_sample) segments_.push_back(segment);
   }
 }
 

@@ -199,8 +199,9 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
           keypoint_cost_->mean_error_px(preliminary) + params_.max_reprojection_increase_px)
     result.accepted = false;
   result.object_to_camera = result.accepted ? optimized.object_to_camera : preliminary;
+  // Both with the contour extracted at the refined pose (the optimizer's last linearization):
+  // no extra extraction.
   result.energy_after = contour_cost_->energy(result.object_to_camera);
-  contour_cost_->linearize(preliminary, 0);
   result.energy_before = contour_cost_->energy(preliminary);
 
   // Stage times: the contour cue's linearizations are the contour extraction, all evaluations

@@ -126,11 +126,11 @@ TEST_F(ContourCostTest, AnalyticGradientMatchesNumericOnEveryLevel) {
     Vector6d analytic = Vector6d::Zero();
     Matrix6d hessian = Matrix6d::Zero();
     cost.evaluate(pose, &analytic, &hessian);
-    // Steps moving the contour by about 0.02 level px: few points cross a pixel cell's border
+    // Steps moving the contour by about 0.005 level px: few points cross a pixel cell's border
     // (where the bilinear interpolation's derivative jumps).
     const double px_m = 0.45 / (camera_.fx() * std::pow(0.5, level));
     const Vector6d numeric =
-        numeric_gradient(cost, pose, frame_.center_object, 0.02 * px_m / 0.07, 0.02 * px_m);
+        numeric_gradient(cost, pose, frame_.center_object, 0.005 * px_m / 0.07, 0.005 * px_m);
     // Tolerance: 2% of the gradient's norm (the cell-border crossings).
     EXPECT_LT((analytic - numeric).norm(), 0.02 * numeric.norm())
         << "level " << level << "\nanalytic " << analytic.transpose() << "\nnumeric "

@@ -14,10 +14,12 @@ namespace kct {
 
 /// Eq. 5 over points held fixed on the model between linearizations.
 ///
-/// linearize() extracts the Contour / Sharp edges at the pose for the pyramid level (Algorithm
-/// 1) and puts n = max(1, round(L / spacing_px)) sample points on each edge of projected length
-/// L (level px), at (k + 0.5) / n of the 3D edge. evaluate() re-projects those points and the
-/// edges' normals and returns
+/// linearize() extracts the Contour / Sharp edges at the pose (Algorithm 1; again only when
+/// the camera centre moved by more than 1% of its distance to the object since the frame's last
+/// extraction, otherwise the same edges are re-projected) and puts sample points every spacing_px (level px) along the projected edges taken one
+/// after the other (the remainder carried over from edge to edge; the spacing grows so that
+/// there are at most kMaxSamples), at the matching fraction of each 3D edge. evaluate()
+/// re-projects those points and the edges' normals and returns
 ///   cost = -E / c,  E = mean over in-image points of |grad I(p) . n|   (Eq. 5 on the level),
 /// c = the level's contrast scale (8 x the mean gradient magnitude around the object), so a
 /// well-aligned contour costs about -1 whatever the image's contrast. The gradient is exact for
@@ -34,6 +36,9 @@ namespace kct {
 /// dropped as if outside the image.
 class ContourCost : public PoseCost {
  public:
+  /// Most sample points per linearization: bounds the cost whatever the mesh and resolution.
+  static constexpr int kMaxSamples = 1000;
+
   /// `spacing_px` (> 0): sample spacing in level px. `blur_sigma_px` (>= 0): Gaussian blur of
   /// each level before differentiating (widens the basin). `num_threads` (>= 1): threads for
   /// the per-frame image derivatives; the result does not depend on it. Throws
@@ -81,7 +86,9 @@ class ContourCost : public PoseCost {
   int level_ = 0;
   std::vector<Segment> segments_;
   std::vector<Eigen::Vector3d> samples_;  ///< object frame, m
-  std::vector<ContourSegment> scratch_;
+  std::vector<ContourSegment> scratch_;  ///< the edges of the last extraction
+  bool extracted_ = false;                ///< scratch_ holds this frame's edges
+  Eigen::Vector3d extracted_camera_ = Eigen::Vector3d::Zero();  ///< camera centre then, object frame
 };
 
 }  // namespace kct

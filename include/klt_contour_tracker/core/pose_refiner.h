@@ -50,7 +50,7 @@ class PoseRefiner {
   /// preliminary pose came from PnP (search area = reprojection constraint, Sec. 3.4), or is
   /// null when it was extrapolated (search area = Euler/translation box).
   /// With optimizer = coarse_to_fine, energy_before/after are Eq. 5 on the full-resolution
-  /// level blurred by blur_sigma_px.
+  /// level blurred by blur_sigma_px, both over the contour extracted at the refined pose.
   RefineResult refine(const cv::Mat& gray, const PinholeCamera& camera, const Pose& preliminary,
                       const KeypointResult* keypoints);
 
