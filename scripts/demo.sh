@@ -4,9 +4,9 @@
 # `roslaunch klt_contour_tracker track_bag.launch` (the bag is played at a rate the tracker can
 # follow: rosbag play pauses on the tracker's ~status), records the output and scores it against
 # the ground truth with evaluate_bag.
-#   KCT_DEMO_PRESET=paper|klt_only (default paper)   KCT_DEMO_FRAMES (default 150)
+#   KCT_DEMO_PRESET=realtime|paper|klt_only (default realtime)   KCT_DEMO_FRAMES (default 150)
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-PRESET="${KCT_DEMO_PRESET:-paper}"
+PRESET="${KCT_DEMO_PRESET:-realtime}"
 FRAMES="${KCT_DEMO_FRAMES:-150}"
 DEMO_DIR="$KCT_DATA/demo"
 BAG="$DEMO_DIR/demo.bag"
