@@ -14,6 +14,7 @@ PACKAGES=(
   python3-geometry-msgs python3-sensor-msgs python3-tf2-msgs
   libgtest-dev libopencv-dev libeigen3-dev libnlopt-cxx-dev libassimp-dev
   opencv-doc cmake g++ make
+  clang libfuzzer-14-dev libclang-rt-14-dev
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

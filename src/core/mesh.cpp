@@ -220,6 +220,73 @@ void check_ascii_stl(const std::string& path, std::istream& in) {
   if (!any_facet) fail("no facet");
 }
 
+/// Checks an OFF file's structure (header, counts, vertex lines of 3 numbers, face lines
+/// "n i_1 .. i_n" with n >= 3 and indices below the vertex count; '#' comments): on malformed
+/// faces assimp 5's triangulation hits an ai_assert that aborts the process (libFuzzer found it;
+/// Debian builds assimp with assertions), which for the nodelet would take down the manager.
+/// Hand-written because assimp offers no validation without importing.
+void check_off(const std::string& path, std::istream& in) {
+  auto fail = [&](const std::string& what) {
+    throw mesh_error(path, "malformed OFF: " + what);
+  };
+  std::vector<std::vector<std::string>> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find('\0') != std::string::npos) fail("NUL byte in line " + std::to_string(lines.size() + 1));
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream words(line);
+    std::vector<std::string> tokens;
+    for (std::string t; words >> t;) tokens.push_back(t);
+    if (!tokens.empty()) lines.push_back(std::move(tokens));
+  }
+  auto integer = [&](const std::string& token, std::uint64_t& value) {
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(token.c_str(), &end, 10);
+    if (end == token.c_str() || *end != '\0' || token[0] == '-') return false;
+    value = v;
+    return true;
+  };
+  auto number = [&](const std::string& token) {
+    char* end = nullptr;
+    std::strtod(token.c_str(), &end);
+    return end != token.c_str() && *end == '\0';
+  };
+  if (lines.empty()) fail("empty file");
+  std::size_t row = 0;
+  std::vector<std::string> counts = lines[row];
+  if (counts[0].size() >= 3 && counts[0].compare(counts[0].size() - 3, 3, "OFF") == 0) {
+    counts.erase(counts.begin());
+    if (counts.empty()) {
+      if (++row >= lines.size()) fail("no counts line");
+      counts = lines[row];
+    }
+  }
+  std::uint64_t vertices = 0, faces = 0;
+  if (counts.size() < 2 || !integer(counts[0], vertices) || !integer(counts[1], faces))
+    fail("the counts line must start with the vertex and face counts");
+  if (lines.size() - row - 1 < vertices + faces)
+    fail("declares " + std::to_string(vertices) + " vertices and " + std::to_string(faces) +
+         " faces but has " + std::to_string(lines.size() - row - 1) + " lines");
+  for (std::uint64_t v = 0; v < vertices; ++v) {
+    const auto& tokens = lines[++row];
+    if (tokens.size() < 3 || !number(tokens[0]) || !number(tokens[1]) || !number(tokens[2]))
+      fail("vertex " + std::to_string(v) + " is not 3 numbers");
+  }
+  for (std::uint64_t f = 0; f < faces; ++f) {
+    const auto& tokens = lines[++row];
+    std::uint64_t n = 0;
+    if (!integer(tokens[0], n) || n < 3 || tokens.size() < n + 1)
+      fail("face " + std::to_string(f) + " is not 'n i_1 .. i_n' with n >= 3");
+    for (std::uint64_t k = 1; k <= n; ++k) {
+      std::uint64_t index = 0;
+      if (!integer(tokens[k], index) || index >= vertices)
+        fail("face " + std::to_string(f) + " has an invalid vertex index '" +
+             truncate_for_message(tokens[k], 32) + "'");
+    }
+  }
+}
+
 /// Checks what a file's header promises against the file's size before assimp reads it:
 /// assimp allocates what a PLY header declares (100M vertices: 1.2 GB for a 200-byte file) and
 /// what a binary STL's facet count says. Hand-written because assimp has no such pre-check.
@@ -294,6 +361,10 @@ void check_header_against_size(const std::string& path) {
       throw mesh_error(path, "PLY header declares elements needing at least " +
                                  std::to_string(needed) + " bytes, but the file has " +
                                  std::to_string(file_size) + " bytes (truncated or corrupt)");
+    return;
+  }
+  if (extension == "off") {
+    check_off(path, in);
     return;
   }
   if (extension == "stl" && head == "solid") {

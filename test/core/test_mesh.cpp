@@ -299,3 +299,20 @@ TEST(Mesh, MalformedAsciiStlIsRefusedBeforeAssimp) {
   std::ofstream(bad) << "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0\nendsolid\n";
   EXPECT_NE(load_error(bad).find("malformed ASCII STL"), std::string::npos) << load_error(bad);
 }
+
+// libFuzzer found a malformed OFF (a face line of NUL bytes) on which assimp's triangulation
+// hits an ai_assert that aborts the process (the nodelet manager, for ~mesh_resource): OFF is
+// now checked before assimp sees it.
+TEST(Mesh, MalformedOffIsRefusedBeforeAssimpAborts) {
+  TempDir dir;
+  const std::string good = dir.file("tetra.off");
+  std::ofstream(good) << "OFF\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  EXPECT_EQ(load_error(good), "");
+  const std::string bad = dir.file("bad.off");
+  std::ofstream(bad, std::ios::binary) << "OFF\n4 4 6\n0 0 0\n1 0 0\n0 0 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3"
+                                       << std::string(12, '\0') << " 0 3 2\n3 1 2 3\n";
+  EXPECT_NE(load_error(bad).find("malformed OFF"), std::string::npos) << load_error(bad);
+  const std::string index = dir.file("index.off");
+  std::ofstream(index) << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+  EXPECT_NE(load_error(index).find("invalid vertex index '7'"), std::string::npos) << load_error(index);
+}

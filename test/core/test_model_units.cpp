@@ -47,8 +47,8 @@ TEST(ModelUnits, RejectsScalesOutsideTheRangeNamingIt) {
       EXPECT_NE(what.find("allowed"), std::string::npos) << what;
     }
   }
-  EXPECT_NO_THROW(ModelUnits(ModelUnits::kMinScale));
-  EXPECT_NO_THROW(ModelUnits(ModelUnits::kMaxScale));
+  EXPECT_NO_THROW(ModelUnits{ModelUnits::kMinScale});
+  EXPECT_NO_THROW(ModelUnits{ModelUnits::kMaxScale});
 }
 
 }  // namespace
