@@ -1,8 +1,10 @@
 #include "klt_contour_tracker/core/contour_extractor.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace kct {
 namespace {
@@ -29,16 +31,15 @@ ContourExtractor::ContourExtractor(std::shared_ptr<const Mesh> mesh,
   const int face_count = static_cast<int>(mesh_->faces.size());
   if (visibility_ && visibility_->face_count() != face_count)
     throw std::invalid_argument("ContourExtractor: visibility table has " +
-                                std::to_string(visibility_->face_count()) +
-                                " faces, the mesh " + std::to_string(face_count));
+                                std::to_string(visibility_->face_count()) + " faces, the mesh " +
+                                std::to_string(face_count));
 
   face_planes_.resize(face_count);
   std::vector<bool> degenerate(face_count);
   for (int f = 0; f < face_count; ++f) {
     const Eigen::Vector3i& face = mesh_->faces[f];
     const Eigen::Vector3d& a = mesh_->vertices[face[0]];
-    const Eigen::Vector3d n =
-        (mesh_->vertices[face[1]] - a).cross(mesh_->vertices[face[2]] - a);
+    const Eigen::Vector3d n = (mesh_->vertices[face[1]] - a).cross(mesh_->vertices[face[2]] - a);
     const double length = n.norm();
     degenerate[f] = !(length > 0.0) || !std::isfinite(length);
     face_planes_[f].normal = degenerate[f] ? Eigen::Vector3d::Zero() : Eigen::Vector3d(n / length);
@@ -51,20 +52,62 @@ ContourExtractor::ContourExtractor(std::shared_ptr<const Mesh> mesh,
   // alpha", i.e. the dihedral angle is at most pi - alpha): the angle between the two unit
   // face normals exceeds alpha, n1 . n2 < cos(alpha). A cube's edges (90 deg) are sharp for
   // alpha = 45 deg, a finely tessellated cylinder's side edges are not.
-  const double cos_alpha = std::cos(sharp_edge_angle_deg * M_PI / 180.0);
-  edges_ = mesh_->shared_edges();
-  edge_info_.reserve(edges_.size());
-  for (const MeshEdge& e : edges_) {
+  cos_alpha_ = std::cos(sharp_edge_angle_deg * M_PI / 180.0);
+
+  // Every edge with its faces: (vertex pair, face) entries sorted by pair. Two-face edges are
+  // listed first (the order of Mesh::shared_edges(), so closed meshes are unchanged), then
+  // boundary and non-manifold edges.
+  std::vector<std::pair<std::uint64_t, int>> entries;
+  entries.reserve(mesh_->faces.size() * 3);
+  for (int f = 0; f < face_count; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = static_cast<std::uint32_t>(mesh_->faces[f][k]);
+      const auto b = static_cast<std::uint32_t>(mesh_->faces[f][(k + 1) % 3]);
+      if (a == b) continue;
+      entries.emplace_back((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b), f);
+    }
+  std::sort(entries.begin(), entries.end());
+  std::vector<EdgeInfo> others;
+  std::vector<MeshEdge> other_edges;
+  std::vector<int> faces;
+  for (std::size_t i = 0; i < entries.size();) {
+    std::size_t j = i;
+    faces.clear();
+    for (; j < entries.size() && entries[j].first == entries[i].first; ++j)
+      if (faces.empty() || faces.back() != entries[j].second) faces.push_back(entries[j].second);
     EdgeInfo info;
-    info.p = e.v0;
-    info.q = e.v1;
-    info.face1 = e.face0;
-    info.face2 = e.face1;
-    info.usable = !degenerate[e.face0] && !degenerate[e.face1];
-    info.sharp = info.usable &&
-                 face_planes_[e.face0].normal.dot(face_planes_[e.face1].normal) < cos_alpha;
-    edge_info_.push_back(info);
+    info.p = static_cast<int>(entries[i].first >> 32);
+    info.q = static_cast<int>(entries[i].first & 0xffffffffu);
+    i = j;
+    if (faces.size() == 2) {
+      info.face1 = faces[0];
+      info.face2 = faces[1];
+      info.usable = !degenerate[faces[0]] && !degenerate[faces[1]];
+      info.sharp = info.usable &&
+                   face_planes_[faces[0]].normal.dot(face_planes_[faces[1]].normal) < cos_alpha_;
+      edge_info_.push_back(info);
+      edges_.push_back({info.p, info.q, faces[0], faces[1]});
+      continue;
+    }
+    if (faces.size() == 1) {
+      info.face1 = faces[0];
+      info.face2 = -1;
+      info.usable = !degenerate[faces[0]];
+      info.sharp = false;
+    } else {
+      info.face1 = info.face2 = -1;
+      info.sharp = false;
+      info.extra_begin = static_cast<int>(extra_faces_.size());
+      for (int f : faces)
+        if (!degenerate[f]) extra_faces_.push_back(f);
+      info.extra_end = static_cast<int>(extra_faces_.size());
+      info.usable = info.extra_end > info.extra_begin;
+    }
+    others.push_back(info);
+    other_edges.push_back({info.p, info.q, faces[0], faces.size() > 1 ? faces[1] : -1});
   }
+  edge_info_.insert(edge_info_.end(), others.begin(), others.end());
+  edges_.insert(edges_.end(), other_edges.begin(), other_edges.end());
   face_state_.resize(face_count);
 }
 
@@ -89,28 +132,49 @@ void ContourExtractor::compute_face_states(const Pose& object_to_camera) const {
     // (v - c) . n < 0 with v on the face: the face's front side looks at the camera.
     const bool front = plane.normal.dot(camera_object) > plane.offset;
     const bool hidden = invisible && ((invisible[f >> 6] >> (f & 63)) & 1u);
-    face_state_[f] = static_cast<std::uint8_t>((front ? kFront : 0) |
-                                               (front && !hidden ? kFrontVisible : 0));
+    face_state_[f] =
+        static_cast<std::uint8_t>((front ? kFront : 0) | (front && !hidden ? kFrontVisible : 0));
   }
+}
+
+template <typename State>
+EdgeType ContourExtractor::edge_type(const EdgeInfo& e, const State& state) const {
+  if (!e.usable) return EdgeType::kOther;
+  if (e.face2 >= 0) {  // Algorithm 1
+    const std::uint8_t s1 = state(e.face1), s2 = state(e.face2);
+    const bool front1 = s1 & kFront, front2 = s2 & kFront;
+    const bool visible1 = s1 & kFrontVisible, visible2 = s2 & kFrontVisible;
+    if ((visible1 && !front2) || (visible2 && !front1)) return EdgeType::kContour;
+    if (visible1 && visible2 && e.sharp) return EdgeType::kSharp;
+    return EdgeType::kOther;
+  }
+  if (e.face1 >= 0)  // boundary edge: an outline wherever its face is seen
+    return (state(e.face1) & kFrontVisible) ? EdgeType::kContour : EdgeType::kOther;
+  // Non-manifold edge: the two-face rule applied to any pair of its faces.
+  bool any_visible = false, any_back = false;
+  for (int k = e.extra_begin; k < e.extra_end; ++k) {
+    const std::uint8_t s = state(extra_faces_[k]);
+    any_visible = any_visible || (s & kFrontVisible);
+    any_back = any_back || !(s & kFront);
+  }
+  if (!any_visible) return EdgeType::kOther;
+  if (any_back) return EdgeType::kContour;
+  for (int k = e.extra_begin; k < e.extra_end; ++k) {
+    if (!(state(extra_faces_[k]) & kFrontVisible)) continue;
+    for (int m = k + 1; m < e.extra_end; ++m)
+      if ((state(extra_faces_[m]) & kFrontVisible) &&
+          face_planes_[extra_faces_[k]].normal.dot(face_planes_[extra_faces_[m]].normal) <
+              cos_alpha_)
+        return EdgeType::kSharp;
+  }
+  return EdgeType::kOther;
 }
 
 void ContourExtractor::classify(const Pose& object_to_camera, std::vector<EdgeType>& types) const {
   compute_face_states(object_to_camera);
   types.resize(edge_info_.size());
-  for (std::size_t i = 0; i < edge_info_.size(); ++i) {
-    const EdgeInfo& e = edge_info_[i];
-    const std::uint8_t s1 = face_state_[e.face1], s2 = face_state_[e.face2];
-    EdgeType type = EdgeType::kOther;
-    if (e.usable) {
-      const bool front1 = s1 & kFront, front2 = s2 & kFront;
-      const bool visible1 = s1 & kFrontVisible, visible2 = s2 & kFrontVisible;
-      if ((visible1 && !front2) || (visible2 && !front1))
-        type = EdgeType::kContour;
-      else if (visible1 && visible2 && e.sharp)
-        type = EdgeType::kSharp;
-    }
-    types[i] = type;
-  }
+  const auto state = [this](int f) { return face_state_[f]; };
+  for (std::size_t i = 0; i < edge_info_.size(); ++i) types[i] = edge_type(edge_info_[i], state);
 }
 
 std::vector<ContourSegment> ContourExtractor::extract(const Pose& object_to_camera,
@@ -125,7 +189,8 @@ void ContourExtractor::rebuild_candidates(const Eigen::Vector3d& camera_object) 
   // (|n| = 1), so a face farther than R from the camera centre keeps its side. An edge whose
   // two faces both keep their side is kOther for every such c when both are back-facing, or
   // both front-facing and the edge is not sharp (Algorithm 1); only the other edges can be
-  // Contour or Sharp and are classified per call.
+  // Contour or Sharp and are classified per call. Boundary and non-manifold edges (few) are
+  // always candidates.
   const Eigen::Vector3d center =
       visibility_ ? visibility_->center_object() : mesh_->bounding_box_center();
   candidate_camera_ = camera_object;
@@ -134,6 +199,10 @@ void ContourExtractor::rebuild_candidates(const Eigen::Vector3d& camera_object) 
   for (std::size_t i = 0; i < edge_info_.size(); ++i) {
     const EdgeInfo& e = edge_info_[i];
     if (!e.usable) continue;
+    if (e.face2 < 0) {
+      candidates_.push_back(static_cast<int>(i));
+      continue;
+    }
     const FacePlane& p1 = face_planes_[e.face1];
     const FacePlane& p2 = face_planes_[e.face2];
     const double s1 = p1.normal.dot(camera_object) - p1.offset;
@@ -151,7 +220,8 @@ void ContourExtractor::extract(const Pose& object_to_camera, const PinholeCamera
   const Eigen::Matrix3d r = object_to_camera.linear();
   const Eigen::Vector3d t = object_to_camera.translation();
   const Eigen::Vector3d camera_object = -(r.transpose() * t);
-  if (!(candidate_radius_ >= 0.0) || !((camera_object - candidate_camera_).norm() <= candidate_radius_))
+  if (!(candidate_radius_ >= 0.0) ||
+      !((camera_object - candidate_camera_).norm() <= candidate_radius_))
     rebuild_candidates(camera_object);
   const std::uint64_t* invisible = nullptr;
   if (visibility_) {
@@ -164,7 +234,7 @@ void ContourExtractor::extract(const Pose& object_to_camera, const PinholeCamera
     invisible = cached_invisible_.data();
   }
   // Same test as compute_face_states(), for the candidates' faces only.
-  auto state = [&](int f) {
+  const auto state = [&](int f) {
     const FacePlane& plane = face_planes_[f];
     const bool front = plane.normal.dot(camera_object) > plane.offset;
     const bool hidden = invisible && ((invisible[f >> 6] >> (f & 63)) & 1u);
@@ -173,14 +243,7 @@ void ContourExtractor::extract(const Pose& object_to_camera, const PinholeCamera
   const std::vector<Eigen::Vector3d>& vertices = mesh_->vertices;
   for (const int i : candidates_) {  // ascending edge order, as a full classify()
     const EdgeInfo& e = edge_info_[i];
-    const std::uint8_t s1 = state(e.face1), s2 = state(e.face2);
-    const bool front1 = s1 & kFront, front2 = s2 & kFront;
-    const bool visible1 = s1 & kFrontVisible, visible2 = s2 & kFrontVisible;
-    EdgeType type = EdgeType::kOther;
-    if ((visible1 && !front2) || (visible2 && !front1))
-      type = EdgeType::kContour;
-    else if (visible1 && visible2 && e.sharp)
-      type = EdgeType::kSharp;
+    const EdgeType type = edge_type(e, state);
     if (type == EdgeType::kOther) continue;
     const Eigen::Vector3d a = r * vertices[e.p] + t;
     const Eigen::Vector3d b = r * vertices[e.q] + t;

@@ -306,5 +306,140 @@ TEST(ContourExtractor, RejectsBadInput) {
   EXPECT_THROW(ContourExtractor(cube, other, 45.0), std::invalid_argument);
 }
 
+
+// --- Open and non-manifold meshes (CAD exports: floors, walls, fins) ---
+
+/// The cube of half size 0.05 m without its +z quad: an open box, its 4 rim edges belong to one
+/// face each.
+std::shared_ptr<const Mesh> make_open_box() {
+  auto mesh = std::make_shared<Mesh>();
+  append_box(*mesh, Eigen::Vector3d::Constant(-0.05), Eigen::Vector3d::Constant(0.05));
+  mesh->faces.erase(mesh->faces.begin() + 2, mesh->faces.begin() + 4);  // the +z quad
+  return mesh;
+}
+
+/// Indices (into edges()) of the edges classified `type` for the pose.
+std::vector<int> edges_of_type(const ContourExtractor& extractor, const Pose& pose, EdgeType type) {
+  std::vector<EdgeType> types;
+  extractor.classify(pose, types);
+  std::vector<int> result;
+  for (std::size_t i = 0; i < types.size(); ++i)
+    if (types[i] == type) result.push_back(static_cast<int>(i));
+  return result;
+}
+
+TEST(ContourExtractor, OpenBoxRimIsContour) {
+  const auto box = make_open_box();
+  const auto table = VisibilityTable::build(*box, 4, 128, "");
+  const ContourExtractor extractor(box, table, 45.0);
+  // 13 two-face edges (12 cube edges minus the 4 rim ones, plus 5 diagonals) and 4 boundary.
+  ASSERT_EQ(extractor.edges().size(), 17u);
+  int boundary = 0;
+  for (const MeshEdge& e : extractor.edges()) boundary += e.face1 < 0;
+  EXPECT_EQ(boundary, 4);
+  // Seen from +x, 45 deg above: only the +x wall faces the camera. All 4 of its sides are the
+  // outline: bottom and sides against back-facing walls, and the rim edge at z = 0.05 (a
+  // boundary edge, which Algorithm 1 alone would drop: only 3 edges).
+  const Pose pose = look_at(0.5 * Eigen::Vector3d(1, 0, 1).normalized());
+  const std::vector<int> contour = edges_of_type(extractor, pose, EdgeType::kContour);
+  EXPECT_EQ(contour.size(), 4u);
+  EXPECT_TRUE(edges_of_type(extractor, pose, EdgeType::kSharp).empty());
+  int rim = 0;
+  for (int i : contour) {
+    const MeshEdge& e = extractor.edges()[i];
+    EXPECT_DOUBLE_EQ(box->vertices[e.v0].x(), 0.05);
+    EXPECT_DOUBLE_EQ(box->vertices[e.v1].x(), 0.05);
+    rim += e.face1 < 0;
+  }
+  EXPECT_EQ(rim, 1);
+  // Projected: 4 segments forming the wall's outline in the image.
+  const std::vector<ContourSegment> segments = extractor.extract(pose, kCamera);
+  EXPECT_EQ(segments.size(), 4u);
+  for (const auto& s : segments) EXPECT_EQ(s.type, EdgeType::kContour);
+}
+
+TEST(ContourExtractor, OpenBoxFromBelow) {
+  // From below, slightly off axis (camera at x, y inside the box's footprint): the bottom quad
+  // is the only front face; its 4 sides are contour (the walls are back-facing), the rim edges
+  // belong to back-facing walls and are not drawn.
+  const auto box = make_open_box();
+  const ContourExtractor extractor(box, VisibilityTable::build(*box, 4, 128, ""), 45.0);
+  const Pose pose = look_at(0.6 * Eigen::Vector3d(0.05, 0.03, -1.0).normalized());
+  const std::vector<int> contour = edges_of_type(extractor, pose, EdgeType::kContour);
+  EXPECT_EQ(contour.size(), 4u);
+  for (int i : contour) {
+    const MeshEdge& e = extractor.edges()[i];
+    EXPECT_DOUBLE_EQ(box->vertices[e.v0].z(), -0.05);
+    EXPECT_DOUBLE_EQ(box->vertices[e.v1].z(), -0.05);
+  }
+}
+
+TEST(ContourExtractor, SinglePolygonOutlinedFromItsFront) {
+  // A hexagon in the z = 0 plane, normal +z, as a fan of 4 triangles: 6 boundary edges and
+  // 3 inner diagonals.
+  auto hexagon = std::make_shared<Mesh>();
+  for (int i = 0; i < 6; ++i)
+    hexagon->vertices.emplace_back(0.05 * std::cos(M_PI * i / 3), 0.05 * std::sin(M_PI * i / 3), 0);
+  for (int i = 1; i < 5; ++i) hexagon->faces.emplace_back(0, i, i + 1);
+  const auto table = VisibilityTable::build(*hexagon, 4, 128, "");
+  const ContourExtractor extractor(hexagon, table, 45.0);
+  ASSERT_EQ(extractor.edges().size(), 9u);
+  const Pose front = look_at(0.5 * Eigen::Vector3d(0.2, 0.1, 1.0).normalized());
+  EXPECT_EQ(count(extractor, front).contour, 6);
+  EXPECT_EQ(count(extractor, front).sharp, 0);
+  // The outline's projection: each boundary edge's segment, about the hexagon's side length
+  // (0.05 m at ~0.5 m: ~50 px).
+  for (const auto& s : extractor.extract(front, kCamera)) {
+    EXPECT_TRUE(kCamera.in_image(s.a_px));
+    EXPECT_NEAR((s.b_px - s.a_px).norm(), 50.0, 10.0);
+  }
+  // From behind the polygon is back-facing: nothing is drawn.
+  const Pose back = look_at(0.5 * Eigen::Vector3d(0.2, 0.1, -1.0).normalized());
+  EXPECT_EQ(count(extractor, back).contour, 0);
+  EXPECT_EQ(count(extractor, back).sharp, 0);
+  // Without a table: the same.
+  EXPECT_EQ(count(ContourExtractor(hexagon, nullptr, 45.0), front).contour, 6);
+}
+
+TEST(ContourExtractor, NonManifoldEdge) {
+  // A plate of two quads (z = 0, normal +z) with a fin (x = 0, normal +x) standing on the
+  // line x = 0 they share: that line is an edge of 3 faces.
+  auto mesh = std::make_shared<Mesh>();
+  mesh->vertices = {{0, -0.05, 0},     {0, 0.05, 0},      {-0.05, -0.05, 0}, {-0.05, 0.05, 0},
+                    {0.05, -0.05, 0},  {0.05, 0.05, 0},   {0, -0.05, 0.05},  {0, 0.05, 0.05}};
+  mesh->faces = {{2, 0, 1}, {2, 1, 3},   // plate x < 0
+                 {0, 4, 5}, {0, 5, 1},   // plate x > 0
+                 {0, 1, 7}, {0, 7, 6}};  // fin, normal +x
+  for (int f = 0; f < 6; ++f) ASSERT_GT(mesh->face_normal(f).sum(), 0.99) << f;
+  const ContourExtractor extractor(mesh, nullptr, 45.0);
+  // Every edge once (13: 6 plate sides, 2 plate diagonals, 3 fin sides, the fin's diagonal and
+  // the spine), the spine among the edges after the two-face ones.
+  ASSERT_EQ(extractor.edges().size(), 13u);
+  int spine = -1;
+  for (std::size_t i = 0; i < extractor.edges().size(); ++i) {
+    const MeshEdge& e = extractor.edges()[i];
+    if (std::min(e.v0, e.v1) == 0 && std::max(e.v0, e.v1) == 1) {
+      EXPECT_EQ(spine, -1) << "the spine is listed twice";
+      spine = static_cast<int>(i);
+    }
+  }
+  ASSERT_GE(spine, 3);
+  // From +x above: plate and fin face the camera, 90 deg apart: the spine is sharp.
+  std::vector<EdgeType> types;
+  extractor.classify(look_at(0.5 * Eigen::Vector3d(1, 0.1, 1).normalized()), types);
+  EXPECT_EQ(types[spine], EdgeType::kSharp);
+  // From -x above: the fin is back-facing, the plate is not: the spine is on the outline.
+  extractor.classify(look_at(0.5 * Eigen::Vector3d(-1, 0.1, 1).normalized()), types);
+  EXPECT_EQ(types[spine], EdgeType::kContour);
+  // From below: nothing faces the camera.
+  extractor.classify(look_at(0.5 * Eigen::Vector3d(-1, 0.1, -1).normalized()), types);
+  for (EdgeType t : types) EXPECT_EQ(t, EdgeType::kOther);
+  // The rest of the plate's outline is found as boundary edges (from +x above: 6 plate sides,
+  // the fin's top and the fin's two vertical sides).
+  const Counts c = count(extractor, look_at(0.5 * Eigen::Vector3d(1, 0.1, 1).normalized()));
+  EXPECT_EQ(c.contour, 9);
+  EXPECT_EQ(c.sharp, 1);
+}
+
 }  // namespace
 }  // namespace kct

@@ -19,7 +19,8 @@ namespace kct {
 /// Type of a mesh edge in a given pose (Algorithm 1).
 enum class EdgeType : std::uint8_t {
   kOther,    ///< not drawn
-  kContour,  ///< one face front-facing and visible, the other back-facing (outer contour)
+  kContour,  ///< one face front-facing and visible, the other back-facing (outer contour),
+             ///< or a boundary edge (one face) whose face is front-facing and visible
   kSharp,    ///< both faces front-facing and visible, normals more than alpha apart
 };
 
@@ -30,7 +31,19 @@ struct ContourSegment {
   int edge = -1;  ///< index into ContourExtractor::edges()
 };
 
-/// Classifies the mesh's shared edges for a pose and projects the Contour and Sharp ones.
+/// Classifies the mesh's edges for a pose and projects the Contour and Sharp ones.
+///
+/// Any mesh is accepted, closed or not (CAD exports are often open: a floor polygon, walls).
+/// Algorithm 1 is defined for an edge shared by two faces; the extension to other edges:
+/// - a boundary edge (one face) is Contour when its face is front-facing and visible: beyond it
+///   there is no surface, so it is an outline (a single polygon seen from its front side is
+///   outlined by all its edges);
+/// - a non-manifold edge (3+ faces, e.g. a wall standing on a floor polygon) is Contour when
+///   one of its faces is front-facing and visible and another is back-facing (the two-face rule
+///   applied to any pair), else Sharp when two of its visible front faces have normals more
+///   than alpha apart.
+/// Degenerate faces (zero area) are ignored, except that a two-face edge with a degenerate face
+/// stays kOther as before (a sliver inside a closed surface must not create an outline).
 ///
 /// Front-facing test: Algorithm 1 evaluates v . n < 0 with v a face vertex in camera
 /// coordinates. Since (R v + t) . (R n) = (v - c) . n with c = -R^T t the camera centre in
@@ -66,7 +79,9 @@ class ContourExtractor {
   void extract(const Pose& object_to_camera, const PinholeCamera& camera,
                std::vector<ContourSegment>& segments) const;
 
-  /// The mesh's edges shared by two faces (Mesh::shared_edges()).
+  /// Every mesh edge with at least one face. Edges shared by two faces come first, in
+  /// Mesh::shared_edges() order; then boundary edges (face1 == -1) and non-manifold edges
+  /// (face0, face1: their first two faces), sorted by vertex pair.
   const std::vector<MeshEdge>& edges() const { return edges_; }
   const Mesh& mesh() const { return *mesh_; }
   /// Null when constructed without a table.
@@ -81,10 +96,16 @@ class ContourExtractor {
   };
   struct EdgeInfo {
     int p, q;          // end points (vertex indices)
-    int face1, face2;  // adjacent faces (v1, q, p) and (v2, p, q) of Algorithm 1
+    int face1, face2;  // adjacent faces (v1, q, p) and (v2, p, q) of Algorithm 1; face2 == -1
+                       // for a boundary edge, both -1 for a non-manifold edge
     bool sharp;        // dihedral test: face normals more than alpha apart
     bool usable;       // false when a face is degenerate (zero area): always kOther
+    int extra_begin = 0, extra_end = 0;  // non-manifold: its faces in extra_faces_
   };
+  /// Algorithm 1 and its extension to boundary / non-manifold edges; `state(face)` gives the
+  /// face's kFront / kFrontVisible bits.
+  template <typename State>
+  EdgeType edge_type(const EdgeInfo& e, const State& state) const;
   /// Fills face_state_: bit 0 front-facing, bit 1 front-facing and not in S.
   void compute_face_states(const Pose& object_to_camera) const;
   /// Selects candidates_ for camera centres within candidate_radius_ of `camera_object`.
@@ -96,6 +117,8 @@ class ContourExtractor {
   std::vector<MeshEdge> edges_;
   std::vector<EdgeInfo> edge_info_;
   std::vector<FacePlane> face_planes_;
+  std::vector<int> extra_faces_;  // faces of non-manifold edges (non-degenerate only)
+  double cos_alpha_ = 1.0;
 
   mutable int cached_icosphere_face_ = -1;
   mutable VisibilityTable::Bits cached_invisible_;

@@ -10,10 +10,11 @@
 
 namespace kct {
 
-/// Edge of the mesh shared by exactly two faces (used for contour / sharp-edge detection).
+/// Edge of the mesh with its faces (used for contour / sharp-edge detection).
 struct MeshEdge {
   int v0, v1;      ///< vertex indices of the edge's end points
-  int face0, face1;  ///< the two faces sharing the edge
+  int face0, face1;  ///< the two faces sharing the edge; face1 == -1 for a boundary edge
+                     ///< (ContourExtractor::edges() only; shared_edges() has two faces always)
 };
 
 /// Triangulated mesh with vertices merged by position, so that every interior edge is shared
