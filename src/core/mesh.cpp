@@ -1,13 +1,12 @@
 #include "klt_contour_tracker/core/mesh.h"
 
-#include "klt_contour_tracker/core/plausibility.h"
-
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cctype>
 #include <array>
 #include <cmath>
 #include <cctype>
@@ -22,6 +21,9 @@
 #include <unordered_map>
 #include <utility>
 
+#include "klt_contour_tracker/core/cao_reader.h"
+#include "klt_contour_tracker/core/plausibility.h"
+
 namespace kct {
 namespace {
 
@@ -35,6 +37,13 @@ std::string parent_folder(const std::string& path) {
 }
 
 bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
+
+bool has_cao_extension(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".cao";
+}
 
 /// Decodes an assimp embedded texture (compressed bytes or raw ARGB8888 texels) to BGR.
 cv::Mat decode_embedded_texture(const aiTexture& texture) {
@@ -509,9 +518,16 @@ Mesh load_mesh(const std::string& path, double scale) {
 
   Assimp::Importer importer;
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_PreTransformVertices | aiProcess_SortByPType;
+  // ViSP's .cao (not an assimp format): read and triangulated by cao_reader, handed to assimp
+  // as OBJ text so that the rest (merging, scale, checks) is shared with every other format.
+  const bool cao = has_cao_extension(path);
+  std::string cao_obj;
+  if (cao) cao_obj = cao_to_obj(read_cao(path));
+  const aiScene* scene = cao ? importer.ReadFileFromMemory(cao_obj.data(), cao_obj.size(), flags,
+                                                           "obj")
+                             : importer.ReadFile(path, flags);
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0)
     throw mesh_error(path, std::string("assimp failed: ") + importer.GetErrorString());
 
@@ -577,7 +593,8 @@ Mesh load_mesh(const std::string& path, double scale) {
     throw mesh_error(path, "every triangle is degenerate (zero area: repeated or collinear corners)");
 
   cv::Vec3b color;
-  if (diffuse_color(*scene, color) && color != cv::Vec3b(0, 0, 0)) result.base_color = color;
+  if (!cao && diffuse_color(*scene, color) && color != cv::Vec3b(0, 0, 0))
+    result.base_color = color;
   if (any_uv) result.texture = load_diffuse_texture(*scene, path);
   if (result.texture.empty()) result.corner_uvs.clear();
   return result;

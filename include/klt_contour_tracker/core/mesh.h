@@ -38,7 +38,8 @@ struct Mesh {
   std::vector<MeshEdge> shared_edges() const;
 };
 
-/// Loads any format assimp reads (OBJ, STL, PLY, DAE, glTF...), triangulates, merges vertices
+/// Loads any format assimp reads (OBJ, STL, PLY, DAE, glTF...) and ViSP's `.cao` (read_cao(),
+/// cao_reader.h; cylinders and circles triangulated), triangulates, merges vertices
 /// at the same position (within 1e-6 of the model size), multiplies coordinates by `scale`
 /// (e.g. 0.001 for a model in millimetres) and loads the first diffuse texture found next to
 /// the file. Throws std::runtime_error naming the file and the reason on failure.
