@@ -1,0 +1,197 @@
+#include "klt_contour_tracker/core/region_cue.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace kct {
+namespace {
+
+constexpr double kMinDepth = 1e-6;  // metres
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+/// The vertex of `face` that is neither end of the edge (v0, v1); -1 if none.
+int opposite_vertex(const Mesh& mesh, int face, int v0, int v1) {
+  for (int k = 0; k < 3; ++k) {
+    const int v = mesh.faces[face][k];
+    if (v != v0 && v != v1) return v;
+  }
+  return -1;
+}
+
+/// d pixel / d increment at 0 of the projection of `point_camera` when the rotation centre is
+/// at `center_camera` (the point moves by w x (point - centre) + v).
+Eigen::Matrix<double, 2, 6> point_jacobian(const Eigen::Vector3d& point_camera,
+                                           const Eigen::Vector3d& center_camera, double fx,
+                                           double fy) {
+  const double inv_z = 1.0 / point_camera.z();
+  Eigen::Matrix<double, 2, 3> dp;
+  dp << fx * inv_z, 0.0, -fx * point_camera.x() * inv_z * inv_z, 0.0, fy * inv_z,
+      -fy * point_camera.y() * inv_z * inv_z;
+  Eigen::Matrix<double, 2, 6> j;
+  j.leftCols<3>() = -dp * skew(point_camera - center_camera);
+  j.rightCols<3>() = dp;
+  return j;
+}
+
+}  // namespace
+
+RegionCue::RegionCue(std::shared_ptr<const ContourExtractor> extractor,
+                     const RegionCueSettings& settings)
+    : extractor_(std::move(extractor)), settings_(settings) {
+  if (!extractor_) throw std::invalid_argument("RegionCue: extractor is null");
+  if (settings.line_half_length_px < 2 || settings.line_half_length_px > 100)
+    throw std::invalid_argument("RegionCue: line_half_length_px must be in [2, 100], got " +
+                                std::to_string(settings.line_half_length_px));
+  if (!(settings.line_spacing_px > 0.0) || !std::isfinite(settings.line_spacing_px))
+    throw std::invalid_argument("RegionCue: line_spacing_px must be > 0");
+  if (!(settings.step_slope_px > 0.0) || !std::isfinite(settings.step_slope_px))
+    throw std::invalid_argument("RegionCue: step_slope_px must be > 0");
+  if (!(settings.step_amplitude > 0.0 && settings.step_amplitude < 0.5))
+    throw std::invalid_argument("RegionCue: step_amplitude must be in (0, 0.5)");
+}
+
+void RegionCue::set_frame(const cv::Mat& bgr, const ColorHistograms& histograms,
+                          const Eigen::Vector3d& center_object) {
+  if (bgr.type() != CV_8UC3 || bgr.cols < 2 || bgr.rows < 2)
+    throw std::invalid_argument("RegionCue::set_frame: bgr must be CV_8UC3, at least 2x2");
+  bgr_ = bgr;
+  histograms_ = &histograms;
+  center_object_ = center_object;
+  posterior_cache_.create(bgr.size(), CV_32F);
+  posterior_cache_.setTo(-1.0f);
+  lines_.clear();
+  contrast_.clear();
+}
+
+float RegionCue::pixel_posterior(int x, int y) const {
+  float& cached = posterior_cache_.at<float>(y, x);
+  if (cached < 0.0f) cached = histograms_->posterior(bgr_.at<cv::Vec3b>(y, x));
+  return cached;
+}
+
+double RegionCue::posterior_at(double x, double y) const {
+  if (!(x >= 0.0 && y >= 0.0 && x <= bgr_.cols - 1.0 && y <= bgr_.rows - 1.0)) return 0.5;
+  const int x0 = std::min(static_cast<int>(x), bgr_.cols - 2);
+  const int y0 = std::min(static_cast<int>(y), bgr_.rows - 2);
+  const double fx = x - x0, fy = y - y0;
+  const double p00 = pixel_posterior(x0, y0), p10 = pixel_posterior(x0 + 1, y0);
+  const double p01 = pixel_posterior(x0, y0 + 1), p11 = pixel_posterior(x0 + 1, y0 + 1);
+  const double top = p00 + fx * (p10 - p00), bottom = p01 + fx * (p11 - p01);
+  return top + fy * (bottom - top);
+}
+
+void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& camera, double scale) {
+  if (!histograms_) throw std::logic_error("RegionCue::linearize: set_frame() was not called");
+  if (!(scale >= 1.0) || !std::isfinite(scale))
+    throw std::invalid_argument("RegionCue::linearize: scale must be >= 1");
+  camera_ = camera;
+  scale_ = scale;
+  lines_.clear();
+  contrast_.clear();
+  const Mesh& mesh = extractor_->mesh();
+  const Pose& pose = object_to_camera;
+  extractor_->extract(pose, camera, segments_);
+  const Eigen::Vector3d camera_object = -(pose.linear().transpose() * pose.translation());
+  const int half = settings_.line_half_length_px;
+  const double spacing = settings_.line_spacing_px * scale;
+
+  for (const ContourSegment& segment : segments_) {
+    if (segment.type != EdgeType::kContour) continue;  // silhouette only
+    const MeshEdge& edge = extractor_->edges()[segment.edge];
+    // The face on the object's side of the outline: the front-facing one.
+    int front = -1, front_count = 0;
+    for (const int face : {edge.face0, edge.face1}) {
+      if (face < 0) continue;
+      const Eigen::Vector3d n = mesh.face_normal(face);
+      if (n.dot(camera_object - mesh.vertices[mesh.faces[face][0]]) > 0.0) {
+        front = face;
+        ++front_count;
+      }
+    }
+    if (front_count != 1) continue;
+    const int inner = opposite_vertex(mesh, front, edge.v0, edge.v1);
+    if (inner < 0) continue;
+    const Eigen::Vector3d inner_camera = pose * mesh.vertices[inner];
+    if (inner_camera.z() <= kMinDepth) continue;
+    const Eigen::Vector2d d = segment.b_px - segment.a_px;
+    const double length = d.norm();
+    if (!(length > 1e-9) || !std::isfinite(length)) continue;
+    Eigen::Vector2d normal(-d.y() / length, d.x() / length);
+    const double side = normal.dot(camera.project(inner_camera) - segment.a_px);
+    if (side == 0.0 || !std::isfinite(side)) continue;
+    if (side > 0.0) normal = -normal;  // outward: away from the front face
+
+    const Eigen::Vector3d& a_object = mesh.vertices[edge.v0];
+    const Eigen::Vector3d& b_object = mesh.vertices[edge.v1];
+    const int count = std::max(1, static_cast<int>(std::lround(length / spacing)));
+    for (int k = 0; k < count; ++k) {
+      const double t = (k + 0.5) / count;
+      Line line;
+      line.point_object = a_object + t * (b_object - a_object);
+      const Eigen::Vector3d point_camera = pose * line.point_object;
+      if (point_camera.z() <= kMinDepth) continue;
+      line.centre_px = camera.project(point_camera);
+      line.normal = normal;
+      line.first = static_cast<int>(contrast_.size());
+      for (int j = -half; j < half; ++j) {
+        const Eigen::Vector2d p = line.centre_px + (j + 0.5) * scale * normal;
+        contrast_.push_back(2.0 * posterior_at(p.x(), p.y()) - 1.0);
+      }
+      lines_.push_back(line);
+    }
+  }
+}
+
+double RegionCue::evaluate(const Pose& object_to_camera, Vector6d* gradient,
+                           Eigen::Matrix<double, 6, 6>* hessian) const {
+  if (lines_.empty()) return 0.0;
+  const int half = settings_.line_half_length_px, pixels = 2 * half;
+  const double k = 1.0 / (2.0 * settings_.step_slope_px * scale_);
+  const double alpha = settings_.step_amplitude;
+  const double inv_ln2 = 1.0 / std::log(2.0);
+  const double norm = 1.0 / (static_cast<double>(lines_.size()) * pixels);
+  const Eigen::Vector3d center_camera = object_to_camera * center_object_;
+  double sum = 0.0;
+  for (const Line& line : lines_) {
+    const Eigen::Vector3d point_camera = object_to_camera * line.point_object;
+    if (point_camera.z() <= kMinDepth) continue;  // counts as uninformative (cost 0)
+    const double delta = line.normal.dot(camera_.project(point_camera) - line.centre_px);
+    double value = 0.0, slope = 0.0, curvature = 0.0;
+    const double* contrast = contrast_.data() + line.first;
+    for (int j = 0; j < pixels; ++j) {
+      const double c = contrast[j];
+      if (c == 0.0) continue;  // unknown pixel: -log2(1/2) - 1 = 0, flat
+      const double s = (j - half + 0.5) * scale_;
+      const double th = std::tanh(k * (s - delta));
+      const double like = 0.5 - alpha * th * c;
+      const double d1 = alpha * c * k * (1.0 - th * th);                 // d like / d delta
+      const double d2 = 2.0 * alpha * c * k * k * th * (1.0 - th * th);  // d2 like / d delta2
+      value += -std::log(like) * inv_ln2 - 1.0;
+      slope += -inv_ln2 * d1 / like;
+      curvature += -inv_ln2 * (d2 / like - (d1 / like) * (d1 / like));
+    }
+    sum += value;
+    if (gradient || hessian) {
+      const Eigen::Matrix<double, 1, 6> a =
+          line.normal.transpose() *
+          point_jacobian(point_camera, center_camera, camera_.fx(), camera_.fy());
+      if (gradient) *gradient += norm * slope * a.transpose();
+      if (hessian && curvature > 0.0) *hessian += norm * curvature * a.transpose() * a;
+    }
+  }
+  return sum * norm;
+}
+
+double RegionCue::cost_at(const Pose& object_to_camera, const PinholeCamera& camera, double scale) {
+  linearize(object_to_camera, camera, scale);
+  return evaluate(object_to_camera, nullptr, nullptr);
+}
+
+}  // namespace kct
