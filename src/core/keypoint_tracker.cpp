@@ -13,10 +13,6 @@
 namespace kct {
 namespace {
 
-// Erosion of the object mask before corner detection, px: corners on the silhouette mostly
-// belong to the background and would be anchored on the wrong surface.
-constexpr int kMaskErosionPx = 3;
-
 Pose pose_from_rvec_tvec(const cv::Mat& rvec, const cv::Mat& tvec) {
   cv::Mat rotation;
   cv::Rodrigues(rvec, rotation);
@@ -83,8 +79,15 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
   options.draw_color = false;
   const RenderOutput render = renderer_.render(object_to_camera, small_camera, options);
   cv::Mat mask = render.mask();
-  cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE,
-                                                  {2 * kMaskErosionPx + 1, 2 * kMaskErosionPx + 1}));
+  // Corners on the silhouette mostly belong to the background (it shows through there) and
+  // would be anchored on the wrong surface: the mask is eroded first (in the KLT frame's px).
+  const int erosion = params_.keypoint_mask_erosion_px > 0
+                          ? std::max(1, static_cast<int>(std::lround(
+                                            params_.keypoint_mask_erosion_px * s)))
+                          : 0;
+  if (erosion > 0)
+    cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                                    {2 * erosion + 1, 2 * erosion + 1}));
   if (!reused_klt_image.empty()) {
     previous_gray_ = reused_klt_image;
     previous_pyramid_ = std::move(reused_pyramid);
@@ -178,7 +181,8 @@ bool KeypointTracker::needs_redetection() const {
 }
 
 KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to_camera_guess,
-                                      const PinholeCamera& camera) {
+                                      const PinholeCamera& camera,
+                                      const KeypointPrediction* prediction) {
   KeypointResult result;
   const auto start = std::chrono::steady_clock::now();
   auto since = [](std::chrono::steady_clock::time_point t) {
@@ -214,8 +218,31 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   std::vector<cv::Point2f> forward, backward;
   std::vector<uchar> status_forward, status_backward;
   std::vector<float> error;
+  // Where the prediction puts each keypoint (behind the camera: where it was), full-res px.
+  std::vector<cv::Point2f> predicted;
+  if (prediction) {
+    predicted.reserve(object_points_.size());
+    for (std::size_t i = 0; i < object_points_.size(); ++i) {
+      const cv::Point3f& p = object_points_[i];
+      const Eigen::Vector3d q = prediction->object_to_camera * Eigen::Vector3d(p.x, p.y, p.z);
+      if (q.z() > 1e-6) {
+        const Eigen::Vector2d uv = camera.project(q);
+        predicted.emplace_back(static_cast<float>(uv.x()), static_cast<float>(uv.y()));
+      } else {
+        predicted.push_back(image_points_[i]);
+      }
+    }
+  }
+  int flow_flags = 0;
+  if (prediction && prediction->initial_flow) {
+    forward = predicted;
+    if (steps > 0)
+      for (cv::Point2f& p : forward) p *= static_cast<float>(s);
+    flow_flags = cv::OPTFLOW_USE_INITIAL_FLOW;
+  }
   cv::calcOpticalFlowPyrLK(previous_pyramid, current_pyramid, start_points, forward,
-                           status_forward, error, window, params_.klt_pyramid_levels, criteria);
+                           status_forward, error, window, params_.klt_pyramid_levels, criteria,
+                           flow_flags);
   backward = start_points;
   cv::calcOpticalFlowPyrLK(current_pyramid, previous_pyramid, forward, backward, status_backward,
                            error, window, params_.klt_pyramid_levels, criteria,
@@ -227,6 +254,7 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
 
   std::vector<cv::Point2f> tracked_image;
   std::vector<cv::Point3f> tracked_object;
+  std::vector<float> prediction_error_px;
   const double fb_limit_sq = params_.klt_forward_backward_px * params_.klt_forward_backward_px;
   for (size_t i = 0; i < image_points_.size(); ++i) {
     if (!status_forward[i] || !status_backward[i]) continue;
@@ -235,6 +263,23 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
     if (!camera.in_image({forward[i].x, forward[i].y})) continue;
     tracked_image.push_back(forward[i]);
     tracked_object.push_back(object_points_[i]);
+    if (prediction)
+      prediction_error_px.push_back(static_cast<float>(cv::norm(forward[i] - predicted[i])));
+  }
+  // Tracks that disagree with the predicted motion (a background corner seen through the
+  // outline, a wrong LK match) are dropped before RANSAC, unless most disagree.
+  if (prediction && prediction->gate_px > 0.0) {
+    std::vector<cv::Point2f> gated_image;
+    std::vector<cv::Point3f> gated_object;
+    for (std::size_t i = 0; i < tracked_image.size(); ++i)
+      if (prediction_error_px[i] <= prediction->gate_px) {
+        gated_image.push_back(tracked_image[i]);
+        gated_object.push_back(tracked_object[i]);
+      }
+    if (2 * gated_image.size() >= tracked_image.size()) {
+      tracked_image.swap(gated_image);
+      tracked_object.swap(gated_object);
+    }
   }
   previous_gray_ = current;
   previous_source_size_ = gray.size();

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "klt_contour_tracker/core/motion_model.h"
 #include "klt_contour_tracker/core/plausibility.h"
 #include "klt_contour_tracker/core/pose_refiner.h"
 
@@ -36,9 +37,28 @@ Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
   if (!size_error.empty()) throw std::invalid_argument("Tracker: " + size_error);
   set_camera(camera);
   if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
+  configure_motion_model();
 }
 
 Tracker::~Tracker() = default;
+
+void Tracker::configure_motion_model() {
+  if (!params_.motion_model) {
+    motion_.reset();
+    return;
+  }
+  MotionModelSettings settings;
+  settings.velocity_smoothing = params_.motion_velocity_smoothing;
+  settings.error_smoothing = params_.motion_error_smoothing;
+  const bool had_pose = motion_ && motion_->initialized();
+  const Pose last = had_pose ? motion_->last_pose() : Pose::Identity();
+  motion_ = std::make_unique<MotionModel>(center_object_, diameter_m_, settings);
+  if (had_pose) motion_->reset(last);
+}
+
+Pose Tracker::predicted_pose() const {
+  return motion_ && motion_->initialized() ? motion_->predict() : pose_i1_;
+}
 
 void Tracker::set_camera(const PinholeCamera& camera) {
   if (camera.width() <= 0 || camera.height() <= 0)
@@ -52,10 +72,15 @@ void Tracker::set_camera(const PinholeCamera& camera) {
 
 void Tracker::set_params(const TrackerParams& params) {
   params.validate();
+  const bool motion_changed =
+      params.motion_model != params_.motion_model ||
+      params.motion_velocity_smoothing != params_.motion_velocity_smoothing ||
+      params.motion_error_smoothing != params_.motion_error_smoothing;
   params_ = params;
   keypoints_.set_params(params_);
   if (params_.refine && !refiner_) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   if (refiner_) refiner_->set_params(params_);
+  if (motion_changed) configure_motion_model();
 }
 
 void Tracker::initialize(const Pose& object_to_camera) {
@@ -67,6 +92,7 @@ void Tracker::initialize(const Pose& object_to_camera) {
   if (!error.empty()) throw std::invalid_argument("Tracker::initialize: implausible pose: " + error);
   pose_i1_ = pose_i2_ = object_to_camera;
   keypoints_.clear();
+  if (motion_) motion_->reset(object_to_camera);
   state_ = State::kPendingFirstFrame;
   frames_since_init_ = 0;
   frames_since_detection_ = 0;
@@ -171,6 +197,7 @@ TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double se
       apply_refinement(refined, result);
     }
     pose_i1_ = pose_i2_ = result.object_to_camera;
+    if (motion_) motion_->reset(pose_i1_);
     keypoints_.clear();
     detect_keypoints(gray, result);
     state_ = State::kTracking;
@@ -207,19 +234,39 @@ TrackResult Tracker::track(const Frame& frame) {
     return finish();
   }
 
+  // Sec. 3.1 with the motion model (ours): its prediction seeds KLT and PnP, gates the tracks
+  // and replaces the two-pose extrapolation when KLT fails.
+  const Pose predicted = predicted_pose();
+  KeypointPrediction prediction;
+  if (motion_) {
+    prediction.object_to_camera = predicted;
+    prediction.initial_flow = params_.klt_predicted_flow;
+    if (params_.keypoint_motion_gate_sigmas > 0.0) {
+      // The prediction's uncertainty at the object, in px: translation and rotation about the
+      // centre moving a point at the object's radius.
+      const Vector6d sigma = motion_->sigma();
+      const double depth_m = std::max(1e-3, (predicted * center_object_).z());
+      const double radius_m = 0.5 * diameter_m_;
+      const double sigma_px = camera_.fx() / depth_m *
+                              (sigma.segment<2>(3).norm() + sigma.head<3>().norm() * radius_m);
+      prediction.gate_px = std::max(3.0, params_.keypoint_motion_gate_sigmas * sigma_px);
+    }
+  }
+
   // The refinement's image work (pyramid, image derivatives) needs only the frame and the
-  // previous pose: with a second thread it runs while KLT does. The same call is made either
+  // expected pose: with a second thread it runs while KLT does. The same call is made either
   // way, so the result does not depend on num_threads.
   const bool prepare = params_.refine && refiner_ && params_.optimizer == "coarse_to_fine";
   std::future<void> prepared;
   if (prepare && params_.num_threads >= 2)
     prepared = std::async(std::launch::async,
-                          [&]() { refiner_->prepare_frame(gray, camera_, pose_i1_); });
+                          [&]() { refiner_->prepare_frame(gray, camera_, predicted); });
   else if (prepare)
-    refiner_->prepare_frame(gray, camera_, pose_i1_);
+    refiner_->prepare_frame(gray, camera_, predicted);
 
   // Sec. 3.1: preliminary pose from KLT + PnP, or extrapolated when KLT fails.
-  result.keypoints = keypoints_.track(gray, pose_i1_, camera_);
+  result.keypoints = keypoints_.track(gray, motion_ ? predicted : pose_i1_, camera_,
+                                      motion_ ? &prediction : nullptr);
   if (prepared.valid()) prepared.get();  // rethrows the preparation's exception, if any
   result.times.klt_ms = result.keypoints.klt_ms;
   result.times.pnp_ms = result.keypoints.pnp_ms;
@@ -228,7 +275,8 @@ TrackResult Tracker::track(const Frame& frame) {
     result.preliminary_object_to_camera = result.keypoints.object_to_camera;
   } else {
     result.status = TrackStatus::kExtrapolated;
-    result.preliminary_object_to_camera = extrapolate_pose(pose_i2_, pose_i1_);
+    result.preliminary_object_to_camera =
+        motion_ ? predicted : extrapolate_pose(pose_i2_, pose_i1_);
   }
   result.object_to_camera = result.preliminary_object_to_camera;
 
@@ -244,6 +292,7 @@ TrackResult Tracker::track(const Frame& frame) {
   // keypoint drift is corrected by the refinement (paper Fig. 4).
   pose_i2_ = pose_i1_;
   pose_i1_ = result.object_to_camera;
+  if (motion_) motion_->update(pose_i1_);
   ++frames_since_init_;
   ++frames_since_detection_;
   const bool interval_due = params_.redetect_interval_frames > 0 &&

@@ -32,6 +32,12 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(ransac_reprojection_px), KCT_FIELD(ransac_iterations), KCT_FIELD(klt_min_points),
       KCT_FIELD(klt_min_inlier_ratio), KCT_FIELD(redetect_ratio), KCT_FIELD(redetect_interval_frames),
       KCT_FIELD(redetect_max_reprojection_increase_px),
+      KCT_FIELD(keypoint_mask_erosion_px), KCT_FIELD(motion_model),
+      KCT_FIELD(motion_velocity_smoothing), KCT_FIELD(motion_error_smoothing),
+      KCT_FIELD(klt_predicted_flow), KCT_FIELD(keypoint_motion_gate_sigmas),
+      KCT_FIELD(motion_prior_weight), KCT_FIELD(region_weight),
+      KCT_FIELD(region_line_half_length_px), KCT_FIELD(region_line_spacing_px),
+      KCT_FIELD(region_band_px), KCT_FIELD(region_learning_rate),
       KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
       KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
       KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
@@ -113,6 +119,16 @@ void TrackerParams::validate() const {
   check_range("redetect_interval_frames", redetect_interval_frames, 0, 1000000);
   check_range("redetect_max_reprojection_increase_px", redetect_max_reprojection_increase_px, 0.0,
               1e6);
+  check_range("keypoint_mask_erosion_px", keypoint_mask_erosion_px, 0, 100);
+  check_range("motion_velocity_smoothing", motion_velocity_smoothing, 1e-6, 1.0);
+  check_range("motion_error_smoothing", motion_error_smoothing, 1e-6, 1.0);
+  check_range("keypoint_motion_gate_sigmas", keypoint_motion_gate_sigmas, 0.0, 1000.0);
+  check_range("motion_prior_weight", motion_prior_weight, 0.0, 1e6);
+  check_range("region_weight", region_weight, 0.0, 1e6);
+  check_range("region_line_half_length_px", region_line_half_length_px, 2, 100);
+  check_range("region_line_spacing_px", region_line_spacing_px, 0.5, 100.0);
+  check_range("region_band_px", region_band_px, 1, 100);
+  check_range("region_learning_rate", region_learning_rate, 1e-6, 1.0);
   check_range("sharp_edge_angle_deg", sharp_edge_angle_deg, 0.0, 180.0);
   check_range("icosphere_subdivisions", icosphere_subdivisions, 0, 6);
   check_range("visibility_resolution_px", visibility_resolution_px, 16, 4096);

@@ -98,5 +98,42 @@ TEST(Tracker, ExtrapolatesWhenTheKeypointsAreLost) {
   }
 }
 
+TEST(Tracker, MotionModelSeedsKltOnFastAcceleratingMotion) {
+  // A textured box slides sideways faster and faster (2 px more each frame, up to 30 px a
+  // frame). Without a pyramid LK captures only ~10 px of motion: started where the keypoints
+  // were, it loses them within a few frames; started from the motion model's prediction
+  // (constant velocity) it only has to find the acceleration and keeps them all the way.
+  auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  Renderer renderer(mesh);
+  const PinholeCamera camera = test::make_camera();
+  const cv::Mat background = test::make_background(camera.size(), 5);
+  TrackerParams params = klt_only();
+  params.klt_pyramid_levels = 0;
+  params.redetect_interval_frames = 1;
+  auto run = [&](bool motion_model, int& keypoint_frames, double& worst_m) {
+    params.motion_model = motion_model;
+    Tracker tracker(mesh, camera, params);
+    Pose truth = test::make_pose(0.45);
+    truth.translation().x() = -0.15;
+    tracker.initialize(truth);
+    keypoint_frames = 0;
+    worst_m = 0.0;
+    for (int i = 0; i < 16; ++i) {
+      if (i > 0) truth.translation().x() += i * 2.0 * 0.45 / 600.0;  // i * 2 px at 0.45 m
+      const cv::Mat image = test::render_frame(renderer, camera, truth, background, 2.0, i);
+      const TrackResult result = tracker.track({image, i / 30.0});
+      if (i > 0) keypoint_frames += result.status == TrackStatus::kKeypoints;
+      worst_m = std::max(worst_m, translation_error(result.object_to_camera, truth));
+    }
+  };
+  int with_frames = 0, without_frames = 0;
+  double with_error = 0.0, without_error = 0.0;
+  run(true, with_frames, with_error);
+  run(false, without_frames, without_error);
+  EXPECT_EQ(with_frames, 15);
+  EXPECT_LT(with_error, 0.005);
+  EXPECT_LT(without_frames, 15);  // the setting is hard enough for plain KLT to fail
+}
+
 }  // namespace
 }  // namespace kct

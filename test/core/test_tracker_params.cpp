@@ -32,6 +32,43 @@ TEST(TrackerParams, KltOnlySkipsTheRefinement) {
   EXPECT_EQ(make_preset("paper").redetect_interval_frames, 1);
 }
 
+TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
+  const TrackerParams p = make_preset("paper");
+  EXPECT_EQ(p.keypoint_mask_erosion_px, 3);
+  EXPECT_FALSE(p.motion_model);
+  EXPECT_DOUBLE_EQ(p.keypoint_motion_gate_sigmas, 0.0);
+  EXPECT_DOUBLE_EQ(p.motion_prior_weight, 0.0);
+  EXPECT_DOUBLE_EQ(p.region_weight, 0.0);
+}
+
+TEST(TrackerParams, CueFieldsAreValidated) {
+  const auto rejects = [](const char* name, const char* value) {
+    TrackerParams p;
+    set_param(p, name, value);
+    try {
+      p.validate();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what()).find(name) != std::string::npos;
+    }
+    return false;
+  };
+  EXPECT_TRUE(rejects("keypoint_mask_erosion_px", "-1"));
+  EXPECT_TRUE(rejects("motion_velocity_smoothing", "0"));
+  EXPECT_TRUE(rejects("motion_error_smoothing", "1.5"));
+  EXPECT_TRUE(rejects("keypoint_motion_gate_sigmas", "-2"));
+  EXPECT_TRUE(rejects("motion_prior_weight", "-0.1"));
+  EXPECT_TRUE(rejects("region_weight", "-1"));
+  EXPECT_TRUE(rejects("region_line_half_length_px", "1"));
+  EXPECT_TRUE(rejects("region_line_spacing_px", "0"));
+  EXPECT_TRUE(rejects("region_band_px", "0"));
+  EXPECT_TRUE(rejects("region_learning_rate", "2"));
+  TrackerParams p;
+  set_param(p, "motion_model", "true");
+  set_param(p, "region_weight", "0.5");
+  EXPECT_NO_THROW(p.validate());
+  EXPECT_TRUE(p.motion_model);
+}
+
 TEST(TrackerParams, UnknownPresetNamesTheKnownOnes) {
   try {
     make_preset("fastest");
@@ -73,7 +110,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 44u);
+  EXPECT_EQ(fields.size(), 56u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

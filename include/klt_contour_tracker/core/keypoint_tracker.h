@@ -36,6 +36,18 @@ struct KeypointResult {
   double pnp_ms = 0.0;  ///< wall time of PnP + RANSAC + LM, ms
 };
 
+/// Where a motion model expects the object in the new frame (ours, not in the paper).
+struct KeypointPrediction {
+  Pose object_to_camera = Pose::Identity();  ///< predicted pose of the new frame
+  /// Start KLT at each keypoint's projection at the predicted pose instead of where it was
+  /// (pyramidal LK then only has to find the motion's unexpected part).
+  bool initial_flow = true;
+  /// > 0: tracks ending farther than this (px) from their predicted position are dropped
+  /// before PnP, unless that would drop more than half of them (then the prediction is what
+  /// is wrong). 0 = no gating.
+  double gate_px = 0.0;
+};
+
 /// True when `refined` keeps the KLT inliers' mean reprojection error within
 /// `max_increase_px` of the PnP pose's (or when KLT failed: nothing to compare). The tracker
 /// re-anchors keypoints only on such poses, so that a refinement that landed in a wrong
@@ -56,9 +68,10 @@ class KeypointTracker {
              bool same_frame_as_track = false);
 
   /// Tracks the anchored keypoints from the previous frame into `gray` and solves PnP from
-  /// `object_to_camera_guess` (used as the RANSAC initial guess). Keeps the inliers.
+  /// `object_to_camera_guess` (used as the RANSAC initial guess). Keeps the inliers. With a
+  /// `prediction`, KLT starts from the predicted positions and/or gates the tracks by them.
   KeypointResult track(const cv::Mat& gray, const Pose& object_to_camera_guess,
-                       const PinholeCamera& camera);
+                       const PinholeCamera& camera, const KeypointPrediction* prediction = nullptr);
 
   /// True when the kept points have thinned below `redetect_ratio` of the last detection.
   bool needs_redetection() const;

@@ -20,6 +20,7 @@ namespace kct {
 class PoseRefiner;
 struct RefineResult;
 class ContourExtractor;
+class MotionModel;
 
 /// One camera image. 8-bit grey (CV_8UC1) or BGR (CV_8UC3); undistorted unless the camera
 /// given to the tracker has distortion coefficients.
@@ -105,6 +106,10 @@ class Tracker {
   /// `same_frame_as_track`: `gray` went through keypoints_.track() in this call.
   double detect_keypoints(const cv::Mat& gray, TrackResult& result,
                           bool same_frame_as_track = false);
+  /// (Re)creates or drops the motion model for params_.motion_model.
+  void configure_motion_model();
+  /// Pose expected in the next frame: the motion model's prediction, else the last pose.
+  Pose predicted_pose() const;
   /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
   std::string check_frame(const Frame& frame) const;
 
@@ -113,6 +118,7 @@ class Tracker {
   TrackerParams params_;
   KeypointTracker keypoints_;
   std::unique_ptr<PoseRefiner> refiner_;
+  std::unique_ptr<MotionModel> motion_;  ///< null unless params_.motion_model
   cv::Mat undistort_map_x_, undistort_map_y_;
   double diameter_m_ = 0.0;                         ///< mesh diameter, metres
   Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();  ///< bounding-box centre, object frame

@@ -44,6 +44,33 @@ struct TrackerParams {
   /// one-frame error instead of being baked into the new anchors.
   double redetect_max_reprojection_increase_px = 0.5;
 
+  // ---- Cues for hand-held motion in clutter (ours, beyond the paper; off in `paper`) --------
+  /// Erosion of the object's rendered mask before corner detection, px: keypoints stay strictly
+  /// inside the silhouette, where the background cannot show through (paper preset: 3).
+  int keypoint_mask_erosion_px = 3;
+  /// Constant-velocity motion model with learned uncertainty (motion_model.h): its prediction
+  /// is the KLT/PnP starting point, the pose when KLT fails (instead of the paper's two-pose
+  /// extrapolation) and the refinement's expected pose.
+  bool motion_model = false;
+  double motion_velocity_smoothing = 0.5;  ///< weight of the newest motion in the velocity, (0, 1]
+  double motion_error_smoothing = 0.3;     ///< weight of the newest error in its variance, (0, 1]
+  /// With motion_model: KLT starts from the keypoints' predicted positions.
+  bool klt_predicted_flow = true;
+  /// With motion_model, > 0: tracks farther than this many standard deviations of the
+  /// prediction (projected to px, at least 3 px) from their predicted position are dropped
+  /// before PnP (unless more than half would be). 0 = off.
+  double keypoint_motion_gate_sigmas = 0.0;
+  /// With motion_model and the coarse_to_fine optimizer: weight of the motion prior cue
+  /// (motion_prior_cost.h), 0 = off.
+  double motion_prior_weight = 0.0;
+  /// With the coarse_to_fine optimizer on colour frames: weight of the region (colour) cue
+  /// (region_cue.h, SRT3D-style correspondence lines), 0 = off.
+  double region_weight = 0.0;
+  int region_line_half_length_px = 12;  ///< pixels sampled on each side of the outline (level 0)
+  double region_line_spacing_px = 6.0;  ///< distance between correspondence lines, px
+  int region_band_px = 10;              ///< width of the bands colours are learned from, px
+  double region_learning_rate = 0.2;    ///< weight of a new frame in the colour histograms, (0, 1]
+
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline
   double sharp_edge_angle_deg = 45.0;      ///< paper: alpha, angle criterion for sharp edges
