@@ -55,16 +55,24 @@ bool ColorHistograms::learn(const cv::Mat& bgr, const cv::Mat& mask, int band_px
   if (!(learning_rate > 0.0 && learning_rate <= 1.0))
     throw std::invalid_argument("ColorHistograms::learn: learning_rate must be in (0, 1], got " +
                                 std::to_string(learning_rate));
-  // Bands along the outline only: a distance band computed with OpenCV's morphology.
+  // Bands along the outline only, computed with OpenCV's morphology inside the object's
+  // bounding box grown by the band (the rest of the frame cannot be in a band).
+  const cv::Rect frame_rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty()) return false;
+  const cv::Rect roi =
+      cv::Rect(box.x - band_px - 1, box.y - band_px - 1, box.width + 2 * band_px + 2,
+               box.height + 2 * band_px + 2) &
+      frame_rect;
   const cv::Mat kernel =
       cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * band_px + 1, 2 * band_px + 1});
-  cv::Mat object = mask != 0, eroded, dilated;
-  cv::erode(object, eroded, kernel);
-  cv::dilate(object, dilated, kernel);
+  cv::Mat object = mask(roi) != 0, eroded, dilated;
+  cv::erode(object, eroded, kernel, {-1, -1}, 1, cv::BORDER_REPLICATE);
+  cv::dilate(object, dilated, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
   const cv::Mat inner = object & ~eroded;
   const cv::Mat outer = dilated & ~object;
   std::vector<float> fg, bg;
-  if (!band_histogram(bgr, inner, fg) || !band_histogram(bgr, outer, bg)) return false;
+  if (!band_histogram(bgr(roi), inner, fg) || !band_histogram(bgr(roi), outer, bg)) return false;
   if (!ready_) {
     foreground_ = fg;
     background_ = bg;

@@ -52,6 +52,7 @@ void KeypointTracker::clear() {
   previous_gray_.release();
   previous_source_size_ = cv::Size();
   previous_pyramid_.clear();
+  object_mask_.release();
   image_points_.clear();
   object_points_.clear();
   detected_count_ = 0;
@@ -78,7 +79,8 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
   RenderOptions options;
   options.draw_color = false;
   const RenderOutput render = renderer_.render(object_to_camera, small_camera, options);
-  cv::Mat mask = render.mask();
+  object_mask_ = render.mask();
+  cv::Mat mask = object_mask_;
   // Corners on the silhouette mostly belong to the background (it shows through there) and
   // would be anchored on the wrong surface: the mask is eroded first (in the KLT frame's px).
   const int erosion = params_.keypoint_mask_erosion_px > 0
@@ -86,8 +88,8 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
                                             params_.keypoint_mask_erosion_px * s)))
                           : 0;
   if (erosion > 0)
-    cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE,
-                                                    {2 * erosion + 1, 2 * erosion + 1}));
+    cv::erode(object_mask_, mask,
+              cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * erosion + 1, 2 * erosion + 1}));
   if (!reused_klt_image.empty()) {
     previous_gray_ = reused_klt_image;
     previous_pyramid_ = std::move(reused_pyramid);

@@ -22,20 +22,6 @@ void check_positive(double value, const char* name) {
 
 }  // namespace
 
-Pose motion_increment_apply(const Pose& object_to_camera, const Vector6d& delta,
-                            const Eigen::Vector3d& center_object) {
-  const Eigen::Vector3d w = delta.head<3>();
-  const double angle = w.norm();
-  const Eigen::Matrix3d r = angle > 0.0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix()
-                                        : Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d center_camera = object_to_camera * center_object;
-  Pose pose = Pose::Identity();
-  pose.linear() = r * object_to_camera.linear();
-  pose.translation() =
-      r * (object_to_camera.translation() - center_camera) + center_camera + delta.tail<3>();
-  return pose;
-}
-
 Vector6d motion_increment_between(const Pose& from, const Pose& to,
                                   const Eigen::Vector3d& center_object) {
   const Eigen::AngleAxisd rotation(Eigen::Matrix3d(to.linear() * from.linear().transpose()));
@@ -91,7 +77,7 @@ void MotionModel::coast() {
 }
 
 Pose MotionModel::predict() const {
-  return motion_increment_apply(last_, velocity_, center_object_);
+  return apply_pose_increment(last_, velocity_, center_object_);
 }
 
 Vector6d MotionModel::sigma() const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -10,12 +11,6 @@ namespace {
 
 constexpr double kMinDepth = 1e-6;  // metres
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
 /// The vertex of `face` that is neither end of the edge (v0, v1); -1 if none.
 int opposite_vertex(const Mesh& mesh, int face, int v0, int v1) {
   for (int k = 0; k < 3; ++k) {
@@ -23,21 +18,6 @@ int opposite_vertex(const Mesh& mesh, int face, int v0, int v1) {
     if (v != v0 && v != v1) return v;
   }
   return -1;
-}
-
-/// d pixel / d increment at 0 of the projection of `point_camera` when the rotation centre is
-/// at `center_camera` (the point moves by w x (point - centre) + v).
-Eigen::Matrix<double, 2, 6> point_jacobian(const Eigen::Vector3d& point_camera,
-                                           const Eigen::Vector3d& center_camera, double fx,
-                                           double fy) {
-  const double inv_z = 1.0 / point_camera.z();
-  Eigen::Matrix<double, 2, 3> dp;
-  dp << fx * inv_z, 0.0, -fx * point_camera.x() * inv_z * inv_z, 0.0, fy * inv_z,
-      -fy * point_camera.y() * inv_z * inv_z;
-  Eigen::Matrix<double, 2, 6> j;
-  j.leftCols<3>() = -dp * skew(point_camera - center_camera);
-  j.rightCols<3>() = dp;
-  return j;
 }
 
 }  // namespace
@@ -99,7 +79,6 @@ void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& cam
   const Pose& pose = object_to_camera;
   extractor_->extract(pose, camera, segments_);
   const Eigen::Vector3d camera_object = -(pose.linear().transpose() * pose.translation());
-  const int half = settings_.line_half_length_px;
   const double spacing = settings_.line_spacing_px * scale;
 
   for (const ContourSegment& segment : segments_) {
@@ -139,51 +118,75 @@ void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& cam
       if (point_camera.z() <= kMinDepth) continue;
       line.centre_px = camera.project(point_camera);
       line.normal = normal;
-      line.first = static_cast<int>(contrast_.size());
-      for (int j = -half; j < half; ++j) {
-        const Eigen::Vector2d p = line.centre_px + (j + 0.5) * scale * normal;
-        contrast_.push_back(2.0 * posterior_at(p.x(), p.y()) - 1.0);
-      }
+      place_line(line, scale);
       lines_.push_back(line);
     }
   }
 }
 
-double RegionCue::evaluate(const Pose& object_to_camera, Vector6d* gradient,
-                           Eigen::Matrix<double, 6, 6>* hessian) const {
-  if (lines_.empty()) return 0.0;
-  const int half = settings_.line_half_length_px, pixels = 2 * half;
-  const double k = 1.0 / (2.0 * settings_.step_slope_px * scale_);
+void RegionCue::place_line(Line& line, double scale) {
+  const int half = settings_.line_half_length_px;
+  contrast_.clear();
+  bool informative = false;
+  for (int j = -half; j < half; ++j) {
+    const Eigen::Vector2d p = line.centre_px + (j + 0.5) * scale * line.normal;
+    contrast_.push_back(2.0 * posterior_at(p.x(), p.y()) - 1.0);
+    informative = informative || contrast_.back() != 0.0;
+  }
+  line.mean_px = 0.0;
+  line.weight = 0.0;
+  if (!informative) return;
+  // log p(d) for d = k scale, |k| < L: sum over the line's pixels (SRT3D Eq. 7-9).
   const double alpha = settings_.step_amplitude;
-  const double inv_ln2 = 1.0 / std::log(2.0);
-  const double norm = 1.0 / (static_cast<double>(lines_.size()) * pixels);
+  const double k_step = 1.0 / (2.0 * settings_.step_slope_px);  // per offset unit (scale px)
+  log_likelihood_.clear();
+  double best = -std::numeric_limits<double>::infinity();
+  for (int k = -(half - 1); k <= half - 1; ++k) {
+    double sum = 0.0;
+    for (int j = -half; j < half; ++j) {
+      const double c = contrast_[j + half];
+      if (c != 0.0) sum += std::log(0.5 - alpha * std::tanh(k_step * (j + 0.5 - k)) * c);
+    }
+    log_likelihood_.push_back(sum);
+    best = std::max(best, sum);
+  }
+  double total = 0.0, mean = 0.0, second = 0.0;
+  for (std::size_t i = 0; i < log_likelihood_.size(); ++i) {
+    const double d = (static_cast<int>(i) - (half - 1)) * scale;
+    const double p = std::exp(log_likelihood_[i] - best);
+    total += p;
+    mean += p * d;
+    second += p * d * d;
+  }
+  mean /= total;
+  const double min_variance = 0.25 * scale * scale;
+  const double variance = std::max(second / total - mean * mean, min_variance);
+  // Variance of a uniform p over the 2L - 1 offsets: a line that tells nothing weighs 0.
+  const double n = 2.0 * half - 1.0;
+  const double uniform_variance = scale * scale * (n * n - 1.0) / 12.0;
+  line.mean_px = mean;
+  line.weight = std::max(0.0, 1.0 / variance - 1.0 / uniform_variance);
+}
+
+double RegionCue::evaluate(const Pose& object_to_camera, Vector6d* gradient,
+                           Matrix6d* hessian) const {
+  if (lines_.empty()) return 0.0;
+  const double norm = 1.0 / static_cast<double>(lines_.size());
   const Eigen::Vector3d center_camera = object_to_camera * center_object_;
   double sum = 0.0;
   for (const Line& line : lines_) {
+    if (line.weight <= 0.0) continue;
     const Eigen::Vector3d point_camera = object_to_camera * line.point_object;
-    if (point_camera.z() <= kMinDepth) continue;  // counts as uninformative (cost 0)
+    if (point_camera.z() <= kMinDepth) continue;
     const double delta = line.normal.dot(camera_.project(point_camera) - line.centre_px);
-    double value = 0.0, slope = 0.0, curvature = 0.0;
-    const double* contrast = contrast_.data() + line.first;
-    for (int j = 0; j < pixels; ++j) {
-      const double c = contrast[j];
-      if (c == 0.0) continue;  // unknown pixel: -log2(1/2) - 1 = 0, flat
-      const double s = (j - half + 0.5) * scale_;
-      const double th = std::tanh(k * (s - delta));
-      const double like = 0.5 - alpha * th * c;
-      const double d1 = alpha * c * k * (1.0 - th * th);                 // d like / d delta
-      const double d2 = 2.0 * alpha * c * k * k * th * (1.0 - th * th);  // d2 like / d delta2
-      value += -std::log(like) * inv_ln2 - 1.0;
-      slope += -inv_ln2 * d1 / like;
-      curvature += -inv_ln2 * (d2 / like - (d1 / like) * (d1 / like));
-    }
-    sum += value;
+    const double error = delta - line.mean_px;
+    sum += 0.5 * line.weight * error * error;
     if (gradient || hessian) {
       const Eigen::Matrix<double, 1, 6> a =
           line.normal.transpose() *
-          point_jacobian(point_camera, center_camera, camera_.fx(), camera_.fy());
-      if (gradient) *gradient += norm * slope * a.transpose();
-      if (hessian && curvature > 0.0) *hessian += norm * curvature * a.transpose() * a;
+          projection_jacobian(point_camera, center_camera, camera_.fx(), camera_.fy());
+      if (gradient) *gradient += (norm * line.weight * error) * a.transpose();
+      if (hessian) *hessian += (norm * line.weight) * a.transpose() * a;
     }
   }
   return sum * norm;

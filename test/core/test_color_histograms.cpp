@@ -66,6 +66,19 @@ TEST(ColorHistograms, SameColourBothSidesGivesNoInformation) {
   EXPECT_NEAR(histograms.posterior(kRed), 0.5f, 1e-6);
 }
 
+TEST(ColorHistograms, ObjectCutByTheImageBorder) {
+  // The disc half outside the image (the bands are computed in a region around the object):
+  // the outline's colours are still learned.
+  cv::Mat image(240, 320, CV_8UC3, cv::Scalar(kBlue[0], kBlue[1], kBlue[2]));
+  cv::Mat mask = cv::Mat::zeros(240, 320, CV_8UC1);
+  cv::circle(mask, {0, 120}, 60, 255, cv::FILLED);
+  image.setTo(cv::Scalar(kRed[0], kRed[1], kRed[2]), mask);
+  ColorHistograms histograms;
+  ASSERT_TRUE(histograms.learn(image, mask, 8, 1.0));
+  EXPECT_GT(histograms.posterior(kRed), 0.98f);
+  EXPECT_LT(histograms.posterior(kBlue), 0.02f);
+}
+
 TEST(ColorHistograms, TooFewPixelsAndBadInput) {
   cv::Mat image, mask;
   red_disc(image, mask);

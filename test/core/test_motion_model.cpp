@@ -27,11 +27,11 @@ TEST(MotionIncrement, BetweenInvertsApply) {
   Vector6d delta;
   delta << 0.1, -0.05, 0.2, 0.03, -0.01, 0.02;
   const Pose from = start_pose();
-  const Pose to = motion_increment_apply(from, delta, kCenter);
+  const Pose to = apply_pose_increment(from, delta, kCenter);
   EXPECT_TRUE(motion_increment_between(from, to, kCenter).isApprox(delta, 1e-12));
   // The rotation part turns about the centre: the centre moves by v only.
   EXPECT_TRUE((to * kCenter - from * kCenter).isApprox(delta.tail<3>(), 1e-12));
-  EXPECT_TRUE(motion_increment_apply(from, Vector6d::Zero(), kCenter).isApprox(from));
+  EXPECT_TRUE(apply_pose_increment(from, Vector6d::Zero(), kCenter).isApprox(from));
 }
 
 TEST(MotionModel, PredictsConstantVelocity) {
@@ -47,10 +47,10 @@ TEST(MotionModel, PredictsConstantVelocity) {
   EXPECT_NEAR(initial_sigma[0], 8.0 * M_PI / 180, 1e-12);
   EXPECT_NEAR(initial_sigma[3], 0.2 * kSize, 1e-12);
   for (int k = 0; k < 25; ++k) {
-    pose = motion_increment_apply(pose, step, kCenter);
+    pose = apply_pose_increment(pose, step, kCenter);
     model.update(pose);
   }
-  const Pose next = motion_increment_apply(pose, step, kCenter);
+  const Pose next = apply_pose_increment(pose, step, kCenter);
   // The smoothed velocity converged: the next pose is predicted within 0.01 deg / 0.1 mm, and
   // the uncertainty shrank to its floors (0.5 deg, 1 % of the size).
   EXPECT_LT(rotation_deg(model.predict(), next), 0.01);
@@ -76,7 +76,7 @@ TEST(MotionModel, UncertaintyFollowsTheJitter) {
     Vector6d jitter;
     jitter << rotation(rng), rotation(rng), rotation(rng), translation(rng), translation(rng),
         translation(rng);
-    pose = motion_increment_apply(start_pose(), jitter, kCenter);
+    pose = apply_pose_increment(start_pose(), jitter, kCenter);
     model.update(pose);
     if (k > 50) {
       sum += model.sigma();
@@ -94,7 +94,7 @@ TEST(MotionModel, CoastingMovesOnAndGrowsTheUncertainty) {
   step[3] = 0.01;
   Pose pose = start_pose();
   model.reset(pose);
-  for (int k = 0; k < 20; ++k) model.update(pose = motion_increment_apply(pose, step, kCenter));
+  for (int k = 0; k < 20; ++k) model.update(pose = apply_pose_increment(pose, step, kCenter));
   const Vector6d before = model.sigma();
   model.coast();  // a frame without a trusted pose
   EXPECT_NEAR((model.last_pose() * kCenter - pose * kCenter).x(), 0.01, 1e-6);

@@ -78,6 +78,10 @@ class KeypointTracker {
   /// Current image positions (px) of the kept keypoints (for debug drawing).
   const std::vector<cv::Point2f>& image_points() const { return image_points_; }
   int num_keypoints() const { return static_cast<int>(image_points_.size()); }
+  /// The object's silhouette rendered by the last detect() (CV_8UC1, 255 on the object, not
+  /// eroded; the KLT frame's size, i.e. halved for frames wider than klt_max_image_width_px),
+  /// e.g. for learning the object's colours at that pose; empty after clear().
+  const cv::Mat& object_mask() const { return object_mask_; }
   void clear();
   void set_params(const TrackerParams& params) { params_ = params; }
 
@@ -97,6 +101,7 @@ class KeypointTracker {
   cv::Size previous_source_size_;  ///< full-resolution size of that frame
   /// cv::buildOpticalFlowPyramid of previous_gray_ (empty until a track() built it).
   std::vector<cv::Mat> previous_pyramid_;
+  cv::Mat object_mask_;  ///< silhouette rendered by the last detect() (KLT frame's size)
   std::vector<cv::Point2f> image_points_;
   std::vector<cv::Point3f> object_points_;
   int detected_count_ = 0;

@@ -6,16 +6,15 @@
 #include <Eigen/Core>
 
 #include "klt_contour_tracker/core/pose.h"
-#include "klt_contour_tracker/core/pose_parametrization.h"
+#include "klt_contour_tracker/core/pose_cost.h"
 
 namespace kct {
 
-/// Frame-to-frame motion as an increment delta = (w, v): w a rotation vector (rad, camera
-/// axes) about the object centre, v the centre's translation (m, camera frame); the pose after
-/// the motion is motion_increment_apply(pose, delta, centre).
-Pose motion_increment_apply(const Pose& object_to_camera, const Vector6d& delta,
-                            const Eigen::Vector3d& center_object);
-/// The increment taking `from` to `to` (exact inverse of motion_increment_apply).
+// Frame-to-frame motions are pose increments as in pose_cost.h: delta = (w, v), w a rotation
+// vector (rad, camera axes) about the object centre, v the centre's translation (m, camera
+// frame); the pose after the motion is apply_pose_increment(pose, delta, centre).
+
+/// The increment taking `from` to `to` (exact inverse of apply_pose_increment).
 Vector6d motion_increment_between(const Pose& from, const Pose& to,
                                   const Eigen::Vector3d& center_object);
 

@@ -20,7 +20,7 @@
 #include "klt_contour_tracker/core/color_histograms.h"
 #include "klt_contour_tracker/core/contour_extractor.h"
 #include "klt_contour_tracker/core/pose.h"
-#include "klt_contour_tracker/core/pose_parametrization.h"
+#include "klt_contour_tracker/core/pose_cost.h"
 
 namespace kct {
 
@@ -38,18 +38,24 @@ struct RegionCueSettings {
 /// inside the object) every line_spacing_px * scale, each through a model point X_i on the
 /// edge, along the outward unit normal n_i (away from the edge's front face), and reads
 /// P_ij = P(foreground | colour) (ColorHistograms; 0.5 outside the image: no information) at
-/// offsets s_j = (j + 0.5) scale, j = -L .. L-1. Lines, normals and posteriors are then held
-/// fixed. evaluate() projects X_i at the pose, takes its shift delta_i = n_i . (pi(X_i) - c_i)
-/// along the line and scores the smoothed step h_f(s) = 1/2 - alpha_h tanh(s / (2 s_h scale))
-/// (probability that offset s lies on the object) against the posteriors:
-///   cost = (1 / (N 2L)) sum_i sum_j [-log2(h_f(s_j - delta_i) P_ij + (1 - h_f) (1 - P_ij)) - 1]
-/// 0 when nothing is known (every P = 1/2), about -0.9 for a perfect fit; N counts every line,
-/// those leaving the image too, so poses pushing the outline out of the image gain nothing.
-/// Gradient: exact for this function; Hessian: sum_i max(d2 cost_i / d delta^2, 0) a_i a_i^T,
-/// a_i = n_i^T d pi(X_i) / d increment.
+/// offsets s_j = (j + 0.5) scale, j = -L .. L-1. With the smoothed step
+/// h_f(s) = 1/2 - alpha_h tanh(s / (2 s_h scale)) (probability that offset s lies on the
+/// object), the likelihood that the outline crosses the line at offset d is
+///   p_i(d) ~ prod_j [h_f(s_j - d) P_ij + (1 - h_f(s_j - d)) (1 - P_ij)]
+/// over d = k scale, |k| < L (SRT3D Eq. 7-9). Its mean mu_i and variance sigma_i^2 (at least
+/// (scale / 2)^2) are held fixed until the next linearize(). evaluate() projects X_i at the
+/// pose, takes its shift delta_i = n_i . (pi(X_i) - c_i) along the line and returns
+///   cost = (1 / N) sum_i 0.5 w_i (delta_i - mu_i)^2,  w_i = 1 / sigma_i^2 - 1 / sigma_u^2,
+/// sigma_u^2 the variance of a uniform p_i (w_i >= 0: a line that tells nothing, all its
+/// P = 1/2 or outside the image, weighs exactly 0; N counts every line, so poses pushing the
+/// outline out of the image gain nothing). This Gaussian form is SRT3D's: its Gauss-Newton step
+/// moves every line's outline point to its most likely position at once, however far.
+/// Gradient exact for this function: (1/N) sum_i w_i (delta_i - mu_i) a_i; Hessian
+/// (1/N) sum_i w_i a_i a_i^T, a_i = n_i^T d pi(X_i) / d increment.
 ///
-/// Pose increment (same as the refiner's cues): delta = (w, v), w a rotation vector (rad,
-/// camera axes) about the object centre, v a translation of that centre (m, camera frame).
+/// Pose increment: pose_cost.h's delta = (w, v), w a rotation vector (rad, camera axes) about
+/// the object centre, v a translation of that centre (m, camera frame). RegionCost
+/// (region_cost.h) puts the cue into the coarse-to-fine objective.
 ///
 /// Not thread-safe (per-frame posterior cache, lines): one instance per thread.
 class RegionCue {
@@ -72,10 +78,10 @@ class RegionCue {
 
   /// Cost at `object_to_camera` with the lines of the last linearize(); when non-null, ADDS
   /// its gradient and Hessian approximation w.r.t. the increment at 0 to `gradient`/`hessian`.
-  double evaluate(const Pose& object_to_camera, Vector6d* gradient,
-                  Eigen::Matrix<double, 6, 6>* hessian) const;
+  double evaluate(const Pose& object_to_camera, Vector6d* gradient, Matrix6d* hessian) const;
 
-  /// linearize() then evaluate() at the same pose (no gradient): a pure function of the pose.
+  /// linearize() then evaluate() at the same pose (no gradient): a pure function of the pose,
+  /// 0.5 w_i mu_i^2 averaged: how far the colours say the outline should move.
   double cost_at(const Pose& object_to_camera, const PinholeCamera& camera, double scale = 1.0);
 
   /// Number of lines of the last linearize() (in and out of the image).
@@ -86,9 +92,12 @@ class RegionCue {
   struct Line {
     Eigen::Vector3d point_object;
     Eigen::Vector2d centre_px, normal;
-    int first;  // index of its 2L posteriors (as P_f - P_b) in contrast_
+    double mean_px = 0.0;  // mu_i
+    double weight = 0.0;   // w_i, 1/px^2
   };
   double posterior_at(double x, double y) const;
+  /// Reads the line's posteriors and sets its mean and weight.
+  void place_line(Line& line, double scale);
   float pixel_posterior(int x, int y) const;
 
   std::shared_ptr<const ContourExtractor> extractor_;
@@ -99,7 +108,8 @@ class RegionCue {
   PinholeCamera camera_;
   double scale_ = 1.0;
   std::vector<Line> lines_;
-  std::vector<double> contrast_;     // 2 P_f - 1 per line pixel
+  std::vector<double> contrast_;        // 2 P_f - 1 per pixel of the line being placed
+  std::vector<double> log_likelihood_;  // log p(d) per offset of the line being placed
   mutable cv::Mat posterior_cache_;  // CV_32F, < 0 = not computed yet
   std::vector<ContourSegment> segments_;
 };
