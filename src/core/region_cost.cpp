@@ -1,7 +1,11 @@
 #include "klt_contour_tracker/core/region_cost.h"
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <stdexcept>
 #include <string>
+
+#include "klt_contour_tracker/core/motion_model.h"
 
 namespace kct {
 
@@ -16,6 +20,9 @@ RegionCost::RegionCost(std::shared_ptr<const ContourExtractor> extractor,
   if (!(learning_rate > 0.0 && learning_rate <= 1.0))
     throw std::invalid_argument("RegionCost: learning_rate must be in (0, 1], got " +
                                 std::to_string(learning_rate));
+  const Mesh& mesh = extractor->mesh();
+  const Eigen::Vector3d center = mesh.bounding_box_center();
+  for (const auto& v : mesh.vertices) radius_m_ = std::max(radius_m_, (v - center).norm());
 }
 
 void RegionCost::begin_frame(const PoseCostFrame& frame) {
@@ -23,12 +30,26 @@ void RegionCost::begin_frame(const PoseCostFrame& frame) {
   frame_ok_ = histograms_.ready() && !frame.bgr.empty() && frame.bgr.type() == CV_8UC3 &&
               !frame.levels.empty() && frame.bgr.size() == frame.levels[0].gray.size();
   if (frame_ok_) cue_.set_frame(frame.bgr, histograms_, frame.center_object);
+  lines_level_ = -1;
 }
 
 void RegionCost::linearize(const Pose& object_to_camera, int level) {
   if (!frame_ok_) return;
   const double scale = 1.0 / frame_->levels.at(level).scale;
-  cue_.linearize(object_to_camera, frame_->levels[0].camera, scale);
+  const PinholeCamera& camera = frame_->levels[0].camera;
+  // The lines are image data along fixed image lines: when no model point moved by more than a
+  // quarter of a line pixel since they were placed, placing them again would read the same.
+  if (level == lines_level_) {
+    const Vector6d motion =
+        motion_increment_between(lines_pose_, object_to_camera, frame_->center_object);
+    const double depth = std::max(1e-3, (object_to_camera * frame_->center_object).z());
+    const double moved_px =
+        camera.fx() / depth * (motion.tail<3>().norm() + motion.head<3>().norm() * radius_m_);
+    if (moved_px < 0.25 * scale) return;
+  }
+  cue_.linearize(object_to_camera, camera, scale);
+  lines_level_ = level;
+  lines_pose_ = object_to_camera;
 }
 
 double RegionCost::evaluate(const Pose& object_to_camera, Vector6d* gradient,

@@ -35,6 +35,11 @@ RegionCue::RegionCue(std::shared_ptr<const ContourExtractor> extractor,
     throw std::invalid_argument("RegionCue: step_slope_px must be > 0");
   if (!(settings.step_amplitude > 0.0 && settings.step_amplitude < 0.5))
     throw std::invalid_argument("RegionCue: step_amplitude must be in (0, 0.5)");
+  // alpha_h tanh((j - k + 0.5) / (2 s_h)) for j - k in [-(2L - 1), 2L - 1] (offset units).
+  const int half = settings.line_half_length_px;
+  for (int m = -(2 * half - 1); m <= 2 * half - 1; ++m)
+    step_table_.push_back(settings.step_amplitude *
+                          std::tanh((m + 0.5) / (2.0 * settings.step_slope_px)));
 }
 
 void RegionCue::set_frame(const cv::Mat& bgr, const ColorHistograms& histograms,
@@ -137,15 +142,15 @@ void RegionCue::place_line(Line& line, double scale) {
   line.weight = 0.0;
   if (!informative) return;
   // log p(d) for d = k scale, |k| < L: sum over the line's pixels (SRT3D Eq. 7-9).
-  const double alpha = settings_.step_amplitude;
-  const double k_step = 1.0 / (2.0 * settings_.step_slope_px);  // per offset unit (scale px)
   log_likelihood_.clear();
   double best = -std::numeric_limits<double>::infinity();
   for (int k = -(half - 1); k <= half - 1; ++k) {
     double sum = 0.0;
+    // alpha tanh(k_step (j + 0.5 - k)) from the table, index j - k + 2 half - 1.
+    const double* step = step_table_.data() + (2 * half - 1) - k;
     for (int j = -half; j < half; ++j) {
       const double c = contrast_[j + half];
-      if (c != 0.0) sum += std::log(0.5 - alpha * std::tanh(k_step * (j + 0.5 - k)) * c);
+      if (c != 0.0) sum += std::log(0.5 - step[j] * c);
     }
     log_likelihood_.push_back(sum);
     best = std::max(best, sum);

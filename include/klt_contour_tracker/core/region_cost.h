@@ -51,6 +51,9 @@ class RegionCost : public PoseCost {
   double learning_rate_;
   const PoseCostFrame* frame_ = nullptr;
   bool frame_ok_ = false;
+  double radius_m_ = 0.0;               ///< largest vertex distance from the bounding-box centre
+  int lines_level_ = -1;                ///< level of the placed lines, -1 = none this frame
+  Pose lines_pose_ = Pose::Identity();  ///< pose the lines were placed at
 };
 
 }  // namespace kct

@@ -108,9 +108,10 @@ class RegionCue {
   PinholeCamera camera_;
   double scale_ = 1.0;
   std::vector<Line> lines_;
+  std::vector<double> step_table_;      // alpha_h tanh of the step per pixel-offset difference
   std::vector<double> contrast_;        // 2 P_f - 1 per pixel of the line being placed
   std::vector<double> log_likelihood_;  // log p(d) per offset of the line being placed
-  mutable cv::Mat posterior_cache_;  // CV_32F, < 0 = not computed yet
+  mutable cv::Mat posterior_cache_;     // CV_32F, < 0 = not computed yet
   std::vector<ContourSegment> segments_;
 };
 
