@@ -64,14 +64,20 @@ void PoseRefiner::add_cue(std::shared_ptr<PoseCost> cue, double weight) {
   prepared_gray_.release();
 }
 
+void PoseRefiner::clear_cues() {
+  extra_cues_.clear();
+  build_cues();
+}
+
 void PoseRefiner::prepare_frame(const cv::Mat& gray, const PinholeCamera& camera,
-                                const Pose& predicted) {
+                                const Pose& predicted, const cv::Mat& bgr) {
   if (params_.optimizer != "coarse_to_fine") return;
   const auto start = std::chrono::steady_clock::now();
   cost_frame_ = PoseCostFrame();
   cost_frame_.levels = make_pyramid(gray, camera, params_.pyramid_levels);
   cost_frame_.predicted_object_to_camera = cost_frame_.preliminary_object_to_camera = predicted;
   cost_frame_.center_object = center_object_;
+  cost_frame_.bgr = bgr;
   costs_.begin_frame(cost_frame_);
   prepared_gray_ = gray;
   prepared_ms_ = elapsed_ms(start);

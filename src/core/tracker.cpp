@@ -9,8 +9,10 @@
 #include <stdexcept>
 
 #include "klt_contour_tracker/core/motion_model.h"
+#include "klt_contour_tracker/core/motion_prior_cost.h"
 #include "klt_contour_tracker/core/plausibility.h"
 #include "klt_contour_tracker/core/pose_refiner.h"
+#include "klt_contour_tracker/core/region_cost.h"
 
 namespace kct {
 
@@ -38,9 +40,39 @@ Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
   set_camera(camera);
   if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   configure_motion_model();
+  configure_cues();
 }
 
 Tracker::~Tracker() = default;
+
+void Tracker::configure_cues() {
+  region_cost_.reset();
+  motion_prior_.reset();
+  if (!refiner_) return;
+  refiner_->clear_cues();
+  if (!params_.refine || params_.optimizer != "coarse_to_fine") return;
+  if (params_.region_weight > 0.0) {
+    RegionCueSettings settings;
+    settings.line_half_length_px = params_.region_line_half_length_px;
+    settings.line_spacing_px = params_.region_line_spacing_px;
+    region_cost_ =
+        std::make_shared<RegionCost>(refiner_->shared_contour_extractor(), settings,
+                                     params_.region_band_px, params_.region_learning_rate);
+    refiner_->add_cue(region_cost_, params_.region_weight);
+  }
+  if (params_.motion_prior_weight > 0.0 && motion_) {
+    motion_prior_ = std::make_shared<MotionPriorCost>();
+    refiner_->add_cue(motion_prior_, params_.motion_prior_weight);
+  }
+}
+
+cv::Mat Tracker::to_bgr(const cv::Mat& image) const {
+  if (image.channels() != 3) return cv::Mat();
+  if (undistort_map_x_.empty()) return image;
+  cv::Mat undistorted;
+  cv::remap(image, undistorted, undistort_map_x_, undistort_map_y_, cv::INTER_LINEAR);
+  return undistorted;
+}
 
 void Tracker::configure_motion_model() {
   if (!params_.motion_model) {
@@ -81,6 +113,7 @@ void Tracker::set_params(const TrackerParams& params) {
   if (params_.refine && !refiner_) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   if (refiner_) refiner_->set_params(params_);
   if (motion_changed) configure_motion_model();
+  configure_cues();  // the colours are learned again
 }
 
 void Tracker::initialize(const Pose& object_to_camera) {
@@ -93,6 +126,7 @@ void Tracker::initialize(const Pose& object_to_camera) {
   pose_i1_ = pose_i2_ = object_to_camera;
   keypoints_.clear();
   if (motion_) motion_->reset(object_to_camera);
+  if (region_cost_) region_cost_->forget();  // a new track may be another scene
   state_ = State::kPendingFirstFrame;
   frames_since_init_ = 0;
   frames_since_detection_ = 0;
@@ -225,9 +259,12 @@ TrackResult Tracker::track(const Frame& frame) {
     return finish();
   }
   const cv::Mat gray = to_gray(frame.image);
+  // The region cue's colour frame (ours): learned from at trusted poses, scored in refine().
+  const cv::Mat bgr = region_cost_ ? to_bgr(frame.image) : cv::Mat();
 
   if (state_ == State::kPendingFirstFrame) {
     detect_keypoints(gray, result);
+    if (region_cost_ && !bgr.empty()) region_cost_->learn(bgr, pose_i1_, camera_);
     state_ = State::kTracking;
     result.status = TrackStatus::kInitialized;
     result.object_to_camera = result.preliminary_object_to_camera = pose_i1_;
@@ -260,9 +297,9 @@ TrackResult Tracker::track(const Frame& frame) {
   std::future<void> prepared;
   if (prepare && params_.num_threads >= 2)
     prepared = std::async(std::launch::async,
-                          [&]() { refiner_->prepare_frame(gray, camera_, predicted); });
+                          [&]() { refiner_->prepare_frame(gray, camera_, predicted, bgr); });
   else if (prepare)
-    refiner_->prepare_frame(gray, camera_, predicted);
+    refiner_->prepare_frame(gray, camera_, predicted, bgr);
 
   // Sec. 3.1: preliminary pose from KLT + PnP, or extrapolated when KLT fails.
   result.keypoints = keypoints_.track(gray, motion_ ? predicted : pose_i1_, camera_,
@@ -282,6 +319,7 @@ TrackResult Tracker::track(const Frame& frame) {
 
   // Sec. 3.2-3.4: contour energy refinement.
   if (params_.refine && refiner_) {
+    if (motion_prior_ && motion_) motion_prior_->set_prediction(predicted, motion_->sigma());
     const RefineResult refined =
         refiner_->refine(gray, camera_, result.preliminary_object_to_camera,
                          result.keypoints.success ? &result.keypoints : nullptr);
@@ -297,13 +335,15 @@ TrackResult Tracker::track(const Frame& frame) {
   ++frames_since_detection_;
   const bool interval_due = params_.redetect_interval_frames > 0 &&
                             frames_since_detection_ >= params_.redetect_interval_frames;
-  if (!result.keypoints.success ||
-      ((keypoints_.needs_redetection() || interval_due) &&
-       (!result.refined ||
-        refined_pose_agrees_with_keypoints(result.keypoints, result.object_to_camera, camera_,
-                                           params_.redetect_max_reprojection_increase_px)))) {
+  const bool agrees =
+      !result.refined ||
+      refined_pose_agrees_with_keypoints(result.keypoints, result.object_to_camera, camera_,
+                                         params_.redetect_max_reprojection_increase_px);
+  if (!result.keypoints.success || ((keypoints_.needs_redetection() || interval_due) && agrees))
     detect_keypoints(gray, result, /*same_frame_as_track=*/true);
-  }
+  // The colours are learned only where keypoints and refinement agree on the pose.
+  if (region_cost_ && !bgr.empty() && result.keypoints.success && agrees)
+    region_cost_->learn(bgr, pose_i1_, camera_);
   return finish();
 }
 

@@ -58,16 +58,22 @@ class PoseRefiner {
   /// derivatives, each cue's begin_frame) for `gray` (CV_8UC1, the frame refine() will get),
   /// with the object expected near `predicted` (e.g. the previous pose). The tracker calls it
   /// on a second thread while KLT runs; refine() does it itself when it was not called.
-  void prepare_frame(const cv::Mat& gray, const PinholeCamera& camera, const Pose& predicted);
+  /// `bgr`: the same frame in colour (CV_8UC3, undistorted) for colour cues, or empty.
+  void prepare_frame(const cv::Mat& gray, const PinholeCamera& camera, const Pose& predicted,
+                     const cv::Mat& bgr = cv::Mat());
 
   /// Adds a cue to the coarse_to_fine objective (e.g. a region or colour cue) with `weight`.
   void add_cue(std::shared_ptr<PoseCost> cue, double weight);
+  /// Removes the cues add_cue() added.
+  void clear_cues();
 
   /// Contour energy (Eq. 5) of a pose on an unblurred frame, for diagnostics.
   double energy(const cv::Mat& gray, const PinholeCamera& camera, const Pose& object_to_camera) const;
 
   void set_params(const TrackerParams& params);
   const ContourExtractor& contour_extractor() const { return *extractor_; }
+  /// The same extractor, shared (e.g. with a cue added by add_cue(); used in the same thread).
+  std::shared_ptr<const ContourExtractor> shared_contour_extractor() const { return extractor_; }
 
  private:
   std::shared_ptr<const Mesh> mesh_;

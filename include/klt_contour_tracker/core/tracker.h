@@ -21,6 +21,8 @@ class PoseRefiner;
 struct RefineResult;
 class ContourExtractor;
 class MotionModel;
+class RegionCost;
+class MotionPriorCost;
 
 /// One camera image. 8-bit grey (CV_8UC1) or BGR (CV_8UC3); undistorted unless the camera
 /// given to the tracker has distortion coefficients.
@@ -108,6 +110,10 @@ class Tracker {
                           bool same_frame_as_track = false);
   /// (Re)creates or drops the motion model for params_.motion_model.
   void configure_motion_model();
+  /// (Re)creates the refiner's region and motion-prior cues for params_ (coarse_to_fine only).
+  void configure_cues();
+  /// The frame in colour, undistorted like to_gray(); empty for a grey frame.
+  cv::Mat to_bgr(const cv::Mat& image) const;
   /// Pose expected in the next frame: the motion model's prediction, else the last pose.
   Pose predicted_pose() const;
   /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
@@ -119,6 +125,8 @@ class Tracker {
   KeypointTracker keypoints_;
   std::unique_ptr<PoseRefiner> refiner_;
   std::unique_ptr<MotionModel> motion_;  ///< null unless params_.motion_model
+  std::shared_ptr<RegionCost> region_cost_;       ///< null unless region_weight > 0
+  std::shared_ptr<MotionPriorCost> motion_prior_;  ///< null unless motion_prior_weight > 0
   cv::Mat undistort_map_x_, undistort_map_y_;
   double diameter_m_ = 0.0;                         ///< mesh diameter, metres
   Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();  ///< bounding-box centre, object frame
