@@ -1,5 +1,7 @@
 #include "klt_contour_tracker/core/renderer.h"
 
+#include "klt_contour_tracker/core/shadow_map.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -139,6 +141,83 @@ cv::Vec3f sample_texture(const cv::Mat& texture, float u, float v) {
 
 }  // namespace
 
+void Renderer::shade_per_pixel(const Pose& object_to_camera, const PinholeCamera& camera,
+                               const RenderOptions& options,
+                               const std::vector<Eigen::Vector3d>& points_camera,
+                               const cv::Mat& uv, RenderOutput& out) const {
+  const Mesh& mesh = *mesh_;
+  const bool textured = !uv.empty();
+  const Eigen::Matrix3d rotation = object_to_camera.linear();
+  std::vector<Eigen::Vector3d> face_normals(mesh.faces.size());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    face_normals[f] = rotation * mesh.face_normal(static_cast<int>(f));
+  std::vector<Eigen::Vector3d> vertex_normals;
+  if (options.smooth_shading) {
+    // Area-weighted: the unnormalized cross product of a face is twice its area times its normal.
+    vertex_normals.assign(mesh.vertices.size(), Eigen::Vector3d::Zero());
+    for (const auto& face : mesh.faces) {
+      const Eigen::Vector3d n = (points_camera[face[1]] - points_camera[face[0]])
+                                    .cross(points_camera[face[2]] - points_camera[face[0]]);
+      for (int k = 0; k < 3; ++k) vertex_normals[face[k]] += n;
+    }
+    for (auto& n : vertex_normals) {
+      const double length = n.norm();
+      if (length > 0.0) n /= length;
+    }
+  }
+  const Eigen::Vector3d light = options.light_direction_camera.normalized();
+  const cv::Vec3f base(mesh.base_color[0], mesh.base_color[1], mesh.base_color[2]);
+  out.color = cv::Mat(out.depth.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int y = 0; y < out.depth.rows; ++y) {
+    const int* face_row = out.face_index.ptr<int>(y);
+    const float* depth_row = out.depth.ptr<float>(y);
+    cv::Vec3b* color_row = out.color.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < out.depth.cols; ++x) {
+      const int f = face_row[x];
+      if (f < 0) continue;
+      const Eigen::Vector3d p = camera.back_project(Eigen::Vector2d(x, y)) * depth_row[x];
+      Eigen::Vector3d n = face_normals[f];
+      if (options.smooth_shading) {
+        // Barycentric coordinates of p in the camera-frame triangle.
+        const Eigen::Vector3i& face = mesh.faces[f];
+        const Eigen::Vector3d a = points_camera[face[0]];
+        const Eigen::Vector3d e1 = points_camera[face[1]] - a, e2 = points_camera[face[2]] - a,
+                              d = p - a;
+        const double d11 = e1.dot(e1), d12 = e1.dot(e2), d22 = e2.dot(e2);
+        const double d1 = d.dot(e1), d2 = d.dot(e2), det = d11 * d22 - d12 * d12;
+        if (det > 0.0) {
+          const double b1 = std::clamp((d22 * d1 - d12 * d2) / det, 0.0, 1.0);
+          const double b2 = std::clamp((d11 * d2 - d12 * d1) / det, 0.0, 1.0 - b1);
+          const Eigen::Vector3d smooth = (1.0 - b1 - b2) * vertex_normals[face[0]] +
+                                         b1 * vertex_normals[face[1]] + b2 * vertex_normals[face[2]];
+          // Keep the face's side: an interpolated normal never points across the face plane.
+          if (smooth.dot(n) > 0.0) n = smooth.normalized();
+          else if (smooth.dot(n) < 0.0) n = -smooth.normalized();
+        }
+      }
+      const Eigen::Vector3d to_eye = -p.normalized();
+      if (n.dot(to_eye) < 0.0) n = -n;  // two-sided: the side seen by the camera
+      const double lit = options.shadow_map ? options.shadow_map->lit_fraction(p) : 1.0;
+      const double n_dot_l = std::max(0.0, n.dot(light));
+      double highlight = 0.0;
+      if (n_dot_l > 0.0 && options.specular > 0.0) {
+        const Eigen::Vector3d half = (light + to_eye).normalized();
+        highlight = options.specular * std::pow(std::max(0.0, n.dot(half)), options.shininess);
+      }
+      cv::Vec3f albedo = base;
+      if (textured) {
+        const cv::Vec2f t = uv.at<cv::Vec2f>(y, x);
+        albedo = sample_texture(mesh.texture, t[0], t[1]);
+      }
+      const double s = options.light_gain * (options.ambient + lit * options.diffuse * n_dot_l);
+      const double white = options.light_gain * lit * highlight * 255.0;
+      color_row[x] = cv::Vec3b(cv::saturate_cast<uchar>(albedo[0] * s + white),
+                               cv::saturate_cast<uchar>(albedo[1] * s + white),
+                               cv::saturate_cast<uchar>(albedo[2] * s + white));
+    }
+  }
+}
+
 Renderer::Renderer(std::shared_ptr<const Mesh> mesh) : mesh_(std::move(mesh)) {
   if (!mesh_) throw std::invalid_argument("Renderer: mesh must not be null");
 }
@@ -197,6 +276,10 @@ RenderOutput Renderer::render(const Pose& object_to_camera, const PinholeCamera&
       if (key[x] > 0.0f) depth[x] = 1.0f / key[x];
   }
   if (!options.draw_color) return out;
+  if (options.specular > 0.0 || options.smooth_shading || options.shadow_map) {
+    shade_per_pixel(object_to_camera, camera, options, points, buffers.uv, out);
+    return out;
+  }
 
   // Flat Lambertian shading per face, two-sided (|n.l|) so inner faces seen through an
   // opening are lit too.

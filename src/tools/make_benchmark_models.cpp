@@ -5,6 +5,10 @@
 ///   chest   (~4k faces)    a box with a barrel lid, metal bands and a lock
 ///   rock    (~20k faces)   an organic, smoothly displaced and elongated icosphere
 ///   bike    (~150k faces)  a bicycle-like frame: two torus wheels with spokes, many tubes
+///   toy     (~8k faces)    UNTEXTURED: a uniform-colour organic toy (a sitting bear-like figure
+///                          of smooth blobs), shading only
+///   castle  (18 faces)     UNTEXTURED and OPEN, like ViSP's castle CAD model: a floor polygon,
+///                          a square tower of four walls and a front wall, no closing faces
 /// Textures are crops of real photographs from the Debian package opencv-doc
 /// (/usr/share/doc/opencv-doc/examples/data, OpenCV's sample data, BSD/Apache licensed), one
 /// per axis direction (+x, -x, +y, -y, +z, -z), applied by a per-face planar (triplanar)
@@ -270,6 +274,45 @@ void make_rock(Builder& b) {
                    [](const Vector3d& d) { return Vector3d(0.028 * d.x(), 0.02 * d.y(), 0.024 * d.z()); });
 }
 
+void make_toy(Builder& b) {
+  auto ellipsoid = [&](int levels, const Vector3d& center, const Vector3d& radii, double wobble) {
+    displaced_sphere(b, levels, center, [=](const Vector3d& d) {
+      const double r = 1.0 + wobble * std::sin(4.0 * d.x() + 1.0) * std::cos(3.0 * d.y());
+      return Vector3d(radii.x() * r * d.x(), radii.y() * r * d.y(), radii.z() * r * d.z());
+    });
+  };
+  ellipsoid(4, {0.0, 0.0, 0.045}, {0.042, 0.036, 0.05}, 0.04);      // body
+  ellipsoid(4, {0.0, -0.006, 0.115}, {0.032, 0.03, 0.03}, 0.02);   // head
+  ellipsoid(2, {0.0, -0.035, 0.108}, {0.012, 0.012, 0.01}, 0.0);   // snout
+  for (double s : {-1.0, 1.0}) {
+    ellipsoid(2, {0.022 * s, -0.002, 0.142}, {0.01, 0.006, 0.01}, 0.0);   // ears
+    ellipsoid(3, {0.045 * s, -0.01, 0.06}, {0.012, 0.013, 0.028}, 0.0);   // arms
+    ellipsoid(3, {0.024 * s, -0.03, 0.01}, {0.015, 0.028, 0.013}, 0.0);   // legs
+  }
+}
+
+/// Open low-poly CAD model: single-sided polygons only (floor, four tower walls without roof
+/// or bottom, a front wall), the kind of mesh CAD exports and ViSP's .cao castle are.
+void make_castle(Builder& b) {
+  const double fx = 0.11, fy = 0.08;  // floor half extents
+  b.quad(b.add({-fx, -fy, 0}), b.add({fx, -fy, 0}), b.add({fx, fy, 0}), b.add({-fx, fy, 0}));
+  // Tower on the back-left of the floor: 4 walls, open top and bottom.
+  const double x0 = -0.09, x1 = -0.03, y0 = 0.0, y1 = 0.06, h = 0.13;
+  const Vector3d corners[4] = {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0}};
+  for (int k = 0; k < 4; ++k) {
+    const Vector3d& p = corners[k];
+    const Vector3d& q = corners[(k + 1) % 4];
+    b.quad(b.add(p), b.add(q), b.add(q + Vector3d(0, 0, h)), b.add(p + Vector3d(0, 0, h)));
+  }
+  // Front wall with a gate: three quads around an opening.
+  const double wy = -0.05, wh = 0.06, g0 = -0.015, g1 = 0.015, gh = 0.035;
+  b.quad(b.add({-0.1, wy, 0}), b.add({g0, wy, 0}), b.add({g0, wy, wh}), b.add({-0.1, wy, wh}));
+  b.quad(b.add({g1, wy, 0}), b.add({0.1, wy, 0}), b.add({0.1, wy, wh}), b.add({g1, wy, wh}));
+  b.quad(b.add({g0, wy, gh}), b.add({g1, wy, gh}), b.add({g1, wy, wh}), b.add({g0, wy, wh}));
+  // A slope (ramp) to the right of the tower.
+  b.quad(b.add({0.02, 0.0, 0}), b.add({0.09, 0.0, 0}), b.add({0.09, 0.07, 0.05}), b.add({0.02, 0.07, 0.05}));
+}
+
 void make_bike(Builder& b) {
   const double R = 0.1, tyre = 0.011;
   const Vector3d rear(-0.17, 0.0, 0.0), front(0.17, 0.0, 0.0), axle = Vector3d::UnitY();
@@ -335,9 +378,37 @@ struct Atlas {
 struct ModelSpec {
   std::string name;
   std::function<void(Builder&)> build;
-  std::vector<std::string> photos;
+  std::vector<std::string> photos;  ///< empty: untextured, uniform `color`
   std::string description;
+  Vector3d color{0.8, 0.5, 0.2};    ///< RGB in [0, 1], untextured models only
 };
+
+/// Writes an untextured model: one material of uniform diffuse colour (Kd), no texture.
+void write_untextured(const ModelSpec& spec, const Builder& b, const std::string& dir) {
+  {
+    std::ofstream mtl(dir + "/" + spec.name + ".mtl");
+    mtl << "# " << spec.name << ": made by klt_contour_tracker's make_benchmark_models (BSD-3-Clause)\n"
+        << "newmtl " << spec.name << "\nKa 1 1 1\nKd " << spec.color.x() << " " << spec.color.y()
+        << " " << spec.color.z() << "\nKs 0 0 0\nillum 1\n";
+    if (!mtl) throw std::runtime_error("cannot write the .mtl of " + spec.name);
+  }
+  const std::string obj_path = dir + "/" + spec.name + ".obj";
+  std::ofstream obj(obj_path);
+  obj << "# " << spec.name << ": " << spec.description
+      << "\n# made by klt_contour_tracker's make_benchmark_models (BSD-3-Clause); metres, z up\n"
+      << "mtllib " << spec.name << ".mtl\no " << spec.name << "\nusemtl " << spec.name << "\n";
+  char line[128];
+  for (const auto& p : b.vertices) {
+    std::snprintf(line, sizeof(line), "v %.6f %.6f %.6f\n", p.x(), p.y(), p.z());
+    obj << line;
+  }
+  for (const auto& t : b.faces) obj << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+  obj.close();
+  if (!obj) throw std::runtime_error("cannot write " + obj_path);
+  const kct::Mesh mesh = kct::load_mesh(obj_path);
+  std::cout << spec.name << ": " << mesh.faces.size() << " faces, " << mesh.vertices.size()
+            << " vertices, diameter " << mesh.diameter() << " m, untextured -> " << obj_path << "\n";
+}
 
 void write_model(const ModelSpec& spec, const std::string& dir, const std::string& photo_dir) {
   Builder b;
@@ -349,6 +420,10 @@ void write_model(const ModelSpec& spec, const std::string& dir, const std::strin
   for (auto& p : b.vertices) p -= center;
   lo -= center;
 
+  if (spec.photos.empty()) {
+    write_untextured(spec, b, dir);
+    return;
+  }
   const Atlas atlas(photo_dir, spec.photos);
   const std::string png = spec.name + ".png";
   if (!cv::imwrite(dir + "/" + png, atlas.image, {cv::IMWRITE_PNG_COMPRESSION, 6}))
@@ -416,7 +491,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h" || i + 1 >= argc) {
-      std::cerr << "usage: make_benchmark_models [--output-dir DIR] [--only can|chest|rock|bike]"
+      std::cerr << "usage: make_benchmark_models [--output-dir DIR] [--only can|chest|rock|bike|toy|castle]"
                    " [--photo-dir DIR]\n";
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
@@ -438,6 +513,10 @@ int main(int argc, char** argv) {
        "organic displaced icosphere (level 5) with a knob, about 170 x 120 x 100 mm"},
       {"bike", make_bike, {"baboon.jpg", "fruits.jpg", "building.jpg", "starry_night.jpg", "smarties.png", "board.jpg"},
        "bicycle-like frame of many tubes, torus wheels with spokes, about 570 x 240 x 330 mm"},
+      {"toy", make_toy, {}, "untextured uniform-colour toy figure of smooth blobs, about 110 x 90 x 150 mm",
+       {0.85, 0.55, 0.15}},
+      {"castle", make_castle, {}, "untextured OPEN low-poly castle: floor, tower walls, front wall, ramp, "
+       "no closing faces, 220 x 160 x 130 mm", {0.75, 0.72, 0.65}},
   };
   try {
     std::filesystem::create_directories(output_dir);

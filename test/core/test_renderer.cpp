@@ -242,3 +242,63 @@ TEST(Renderer, OrthographicFaceIndexSeesOnlyFrontFaces) {
   EXPECT_THROW(renderer.render_face_index_orthographic({0, 0, 0}, resolution),
                std::invalid_argument);
 }
+
+namespace {
+
+/// A large square (two triangles) in the plane z = 0 of its frame, facing -z... and +z.
+std::shared_ptr<kct::Mesh> make_square(double half) {
+  auto mesh = std::make_shared<kct::Mesh>();
+  mesh->vertices = {{-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
+  mesh->faces = {{0, 1, 2}, {0, 2, 3}};
+  mesh->base_color = cv::Vec3b(100, 100, 100);
+  return mesh;
+}
+
+}  // namespace
+
+TEST(Renderer, SpecularHighlightIsWhereTheHalfVectorMeetsTheNormal) {
+  // A wall facing the camera, light from the camera: Blinn-Phong's highlight is at the image
+  // point whose view ray is along the normal, i.e. the principal point; diffuse-only shading
+  // (flat) is uniform.
+  const auto wall = make_square(0.5);
+  const kct::Renderer renderer(wall);
+  const kct::Pose pose = make_pose({0, 0, 1}, 0.0, {0.0, 0.0, 0.5});
+  kct::RenderOptions options;
+  options.light_direction_camera = Eigen::Vector3d(0, 0, -1);
+  const cv::Mat flat = renderer.render(pose, kCamera, options).color;
+  options.specular = 0.5;
+  options.shininess = 50.0;
+  const cv::Mat shiny = renderer.render(pose, kCamera, options).color;
+  const auto grey = [](const cv::Mat& image, int x, int y) { return image.at<cv::Vec3b>(y, x)[1]; };
+  EXPECT_EQ(grey(flat, 320, 240), grey(flat, 20, 20));  // flat: uniform
+  EXPECT_GT(grey(shiny, 320, 240), grey(flat, 320, 240) + 60);  // highlight at the centre
+  EXPECT_LT(std::abs(grey(shiny, 20, 20) - grey(flat, 20, 20)), 15);  // none at the corner
+  // Defaults unchanged: the per-pixel path is off unless asked for.
+  EXPECT_EQ(cv::norm(renderer.render(pose, kCamera).color,
+                     renderer.render(pose, kCamera, kct::RenderOptions{}).color, cv::NORM_INF),
+            0.0);
+}
+
+TEST(Renderer, SmoothShadingVariesAcrossAFaceFlatDoesNot) {
+  const auto cube = make_cube(0.1);
+  const kct::Renderer renderer(cube);
+  const kct::Pose pose = make_pose({1, 1, 0}, 0.6, {0.0, 0.0, 0.5});
+  kct::RenderOptions options;
+  options.specular = 1e-9;  // per-pixel path, no visible highlight
+  const kct::RenderOutput flat = renderer.render(pose, kCamera, options);
+  options.smooth_shading = true;
+  const kct::RenderOutput smooth = renderer.render(pose, kCamera, options);
+  // Within one face, flat shading has one grey level; smooth shading a range of them.
+  const int face = flat.face_index.at<int>(240, 320);
+  ASSERT_GE(face, 0);
+  double flat_min = 255, flat_max = 0, smooth_min = 255, smooth_max = 0;
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < 640; ++x) {
+      if (flat.face_index.at<int>(y, x) != face) continue;
+      const double f = flat.color.at<cv::Vec3b>(y, x)[0], s = smooth.color.at<cv::Vec3b>(y, x)[0];
+      flat_min = std::min(flat_min, f), flat_max = std::max(flat_max, f);
+      smooth_min = std::min(smooth_min, s), smooth_max = std::max(smooth_max, s);
+    }
+  EXPECT_LE(flat_max - flat_min, 1.0);
+  EXPECT_GT(smooth_max - smooth_min, 10.0);
+}

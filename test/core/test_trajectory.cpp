@@ -104,3 +104,68 @@ TEST(SyntheticTrajectory, NamesAndValidation) {
   EXPECT_GT(big.distance_min_m(), 0.35);
   EXPECT_NEAR(big.distance_max_m() / big.distance_min_m(), 0.6 / 0.35, 1e-12);
 }
+
+TEST(HandheldTrajectory, SpeedLimitsHoldJerksHappenAndItStaysInView) {
+  kct::HandheldParams params;
+  params.seed = 5;
+  params.frames = 600;
+  const kct::HandheldTrajectory trajectory(params, kCamera, kCenter, kDiameter);
+  const double radius = 0.5 * kDiameter;
+  double largest_step = 0.0, largest_turn = 0.0;
+  int fast_frames = 0, direction_changes = 0;
+  Eigen::Vector3d previous_step = Eigen::Vector3d::Zero();
+  for (int i = 1; i <= params.frames; ++i) {
+    const Eigen::Vector3d step = trajectory.frame_center_camera(i) - trajectory.frame_center_camera(i - 1);
+    // The centre is where the pose puts the object's bounding-box centre.
+    EXPECT_LT((trajectory.frame_pose(i) * kCenter - trajectory.frame_center_camera(i)).norm(), 1e-9);
+    largest_step = std::max(largest_step, step.norm());
+    largest_turn = std::max(largest_turn,
+                            kct::rotation_error_deg(trajectory.frame_pose(i), trajectory.frame_pose(i - 1)));
+    if (step.norm() > 0.015) ++fast_frames;
+    if (previous_step.norm() > 0.005 && step.norm() > 0.005 && step.dot(previous_step) < 0.0)
+      ++direction_changes;
+    previous_step = step;
+    const Eigen::Vector3d c = trajectory.frame_center_camera(i);
+    const Eigen::Vector2d p = kCamera.project(c);
+    const double r_px = radius * kCamera.fx() / c.z();
+    EXPECT_GT(p.x() + 0.5 * r_px, 0.0) << "frame " << i;  // at least half of it in view
+    EXPECT_LT(p.x() - 0.5 * r_px, kCamera.width()) << "frame " << i;
+    EXPECT_GT(p.y() + 0.5 * r_px, 0.0) << "frame " << i;
+    EXPECT_LT(p.y() - 0.5 * r_px, kCamera.height()) << "frame " << i;
+  }
+  EXPECT_LE(largest_step, 0.030 + 1e-9);
+  EXPECT_LE(largest_turn, 8.0 + 1e-6);
+  EXPECT_GT(largest_step, 0.02);  // the limits are reached, not only respected
+  EXPECT_GT(largest_turn, 5.0);
+  EXPECT_GT(fast_frames, 10);
+  EXPECT_GT(direction_changes, 5);
+}
+
+TEST(HandheldTrajectory, DeterministicInterpolatedAndLeavesTheImageWhenAsked) {
+  kct::HandheldParams params;
+  params.seed = 9;
+  params.frames = 90;
+  params.leave_start_frame = 30;
+  params.leave_frames = 15;
+  const kct::HandheldTrajectory a(params, kCamera, kCenter, kDiameter);
+  const kct::HandheldTrajectory b(params, kCamera, kCenter, kDiameter);
+  for (int i = 0; i <= 90; ++i)
+    EXPECT_TRUE(a.frame_pose(i).isApprox(b.frame_pose(i), 0.0)) << "frame " << i;
+  // Half way between two frames: the centre is the midpoint.
+  const Eigen::Vector3d mid = a.object_to_camera(10.5 / 30.0) * kCenter;
+  EXPECT_LT((mid - 0.5 * (a.frame_center_camera(10) + a.frame_center_camera(11))).norm(), 1e-9);
+  bool left = false;
+  for (int i = 30; i < 50; ++i) {
+    const Eigen::Vector2d p = kCamera.project(a.frame_center_camera(i));
+    const double r_px = 0.5 * kDiameter * kCamera.fx() / a.frame_center_camera(i).z();
+    left = left || p.x() + r_px < 0.0 || p.x() - r_px > kCamera.width();
+  }
+  EXPECT_TRUE(left);
+  const Eigen::Vector2d back = kCamera.project(a.frame_center_camera(90));
+  EXPECT_TRUE(kCamera.in_image(back)) << back.transpose();
+  params.seed = 10;
+  const kct::HandheldTrajectory other(params, kCamera, kCenter, kDiameter);
+  EXPECT_FALSE(other.frame_pose(20).isApprox(a.frame_pose(20), 1e-6));
+  params.max_translation_m = 0.0;
+  EXPECT_THROW(kct::HandheldTrajectory(params, kCamera, kCenter, kDiameter), std::invalid_argument);
+}

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <memory>
+#include <vector>
 
 #include "klt_contour_tracker/core/camera.h"
 #include "klt_contour_tracker/core/mesh.h"
@@ -13,7 +14,11 @@
 
 namespace kct {
 
-/// Shading of the colour image.
+class ShadowMap;
+
+/// Shading of the colour image. With the defaults (no specular term, flat shading, no shadow
+/// map) the output is the flat two-sided Lambertian shading the tests and the visibility
+/// table were written against; any of the three options below switches to per-pixel shading.
 struct RenderOptions {
   bool draw_color = true;  ///< produce RenderOutput::color (else only depth + face index)
   /// Direction *towards* the light in the camera frame (normalized inside).
@@ -21,6 +26,16 @@ struct RenderOptions {
   double ambient = 0.45;   ///< ambient light factor, [0, 1]
   double diffuse = 0.65;   ///< Lambertian light factor, [0, inf)
   double light_gain = 1.0; ///< global multiplier (flash / dimming effects)
+  /// Blinn-Phong specular factor of a white highlight, [0, inf) (0: none). Per pixel, with
+  /// the half vector of the light direction and the direction to the eye.
+  double specular = 0.0;
+  double shininess = 32.0;  ///< Blinn-Phong exponent, > 0 (larger: smaller, sharper highlight)
+  /// Normals interpolated from area-weighted vertex normals (smooth surfaces) instead of one
+  /// normal per face.
+  bool smooth_shading = false;
+  /// Cast shadows: the diffuse and specular terms are scaled by this map's lit fraction at
+  /// each pixel's camera-frame point (not owned; must outlive the render call). Null: none.
+  const ShadowMap* shadow_map = nullptr;
 };
 
 /// What one render produces; every image has the camera's size.
@@ -53,6 +68,12 @@ class Renderer {
   const Mesh& mesh() const { return *mesh_; }
 
  private:
+  /// Per-pixel shading (specular, smooth normals, shadows) of a finished depth/face render.
+  void shade_per_pixel(const Pose& object_to_camera, const PinholeCamera& camera,
+                       const RenderOptions& options,
+                       const std::vector<Eigen::Vector3d>& points_camera, const cv::Mat& uv,
+                       RenderOutput& out) const;
+
   std::shared_ptr<const Mesh> mesh_;
 };
 

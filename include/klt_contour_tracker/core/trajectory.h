@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "klt_contour_tracker/core/camera.h"
 #include "klt_contour_tracker/core/pose.h"
@@ -80,6 +81,59 @@ class SyntheticTrajectory {
   double weight_[6][3] = {};
   double flash_levels_[64] = {};
   double in_plane_direction_ = 1.0;
+};
+
+/// Settings of a hand-held trajectory (per-frame limits at `frame_rate_hz`).
+struct HandheldParams {
+  uint64_t seed = 1;             ///< same seed, same trajectory
+  int frames = 90;               ///< frames simulated (poses exist for times in [0, frames])
+  double frame_rate_hz = 30.0;
+  double distance_m = 0.45;      ///< nominal distance of the object centre, metres
+  double distance_range_m = 0.12;  ///< the centre stays within distance_m +- this, metres
+  /// Hard limits of the centre's motion and of the rotation between consecutive frames.
+  double max_translation_m = 0.030;
+  double max_rotation_deg = 8.0;
+  /// Per-axis standard deviation of the steady (jerk-free) velocity, per frame.
+  double typical_translation_m = 0.008;
+  double typical_rotation_deg = 2.0;
+  /// Probability per frame of a jerk: the velocity is replaced by one in a random direction
+  /// at 50-100 % of the limits (a hand starting, stopping or changing direction).
+  double jerk_probability = 0.07;
+  /// Frames [leave_start_frame, leave_start_frame + leave_frames) pull the object out of the
+  /// image sideways; it comes back afterwards. leave_frames = 0: it stays in view.
+  int leave_start_frame = -1;
+  int leave_frames = 0;
+};
+
+/// Hand-held object motion: a damped random walk of the velocity (per-axis AR(1), the
+/// "hand tremor and drift"), random jerks, a soft spring that keeps the object near the image
+/// centre at the nominal distance and its orientation near an upright start (object z up, seen
+/// from 35 deg above, seeded yaw), and hard limits per frame. Simulated once per frame; poses
+/// between frames are interpolated (linear centre, slerp rotation) for motion blur.
+class HandheldTrajectory {
+ public:
+  /// `object_center` and `object_diameter_m` in the object frame (Mesh::bounding_box_center,
+  /// Mesh::diameter). The nominal distance is increased when the object would not fit in the
+  /// image. Throws std::invalid_argument on a non-positive limit, distance, diameter or rate.
+  HandheldTrajectory(const HandheldParams& params, const PinholeCamera& camera,
+                     const Eigen::Vector3d& object_center, double object_diameter_m);
+
+  /// Ground-truth object_to_camera at `time_s` (clamped to the simulated span), metres.
+  Pose object_to_camera(double time_s) const;
+  /// Ground-truth object_to_camera of frame `index`.
+  Pose frame_pose(int index) const { return object_to_camera(index / params_.frame_rate_hz); }
+  /// Object centre in the camera frame at frame `index` (metres).
+  Eigen::Vector3d frame_center_camera(int index) const;
+  /// Nominal distance actually used (after fitting the object into the image), metres.
+  double distance_m() const { return distance_; }
+  const HandheldParams& params() const { return params_; }
+
+ private:
+  HandheldParams params_;
+  Eigen::Vector3d object_center_;
+  double distance_ = 0.0;
+  std::vector<Eigen::Vector3d> centers_;      ///< per frame, camera frame
+  std::vector<Eigen::Quaterniond> rotations_;  ///< per frame, object to camera
 };
 
 }  // namespace kct
