@@ -376,8 +376,8 @@ Scene make_scene(const Options& o, const kct::Mesh& object, double nominal_dista
   scene.wall_depth_m = farthest + 0.5 * diameter + 0.25;
   if (o.occluder_passes > 0) {
     // A forearm-sized, skin-coloured cylinder.
-    scene.occluder_radius_m = 0.035;
-    scene.occluder = make_cylinder(scene.occluder_radius_m, 0.4, 48, cv::Vec3b(120, 150, 200));
+    scene.occluder_radius_m = 0.03;
+    scene.occluder = make_cylinder(scene.occluder_radius_m, 0.3, 48, cv::Vec3b(120, 150, 200));
     const int span = std::max(1, o.frames / o.occluder_passes);
     scene.occluder_directions = cv::Mat(o.occluder_passes, 1, CV_64F);
     for (int p = 0; p < o.occluder_passes; ++p) {
@@ -390,9 +390,10 @@ Scene make_scene(const Options& o, const kct::Mesh& object, double nominal_dista
   return scene;
 }
 
-/// Pose of the occluder at `frame_time` (fractional frame index) when it is in a pass: it
-/// sweeps across the object in the image plane, 6 cm in front of it, covering up to about half
-/// of it (its axis passes a quarter of the object's radius off the centre).
+/// Pose of the occluder at `frame_time` (fractional frame index) when it is in a pass: like a
+/// hand reaching in front of the object and back, it comes in from one side (in the image
+/// plane, 3 cm in front of the object) until its edge reaches the object's centre (about half
+/// of the object hidden) and withdraws.
 std::optional<kct::Pose> occluder_pose(const Scene& scene, double frame_time,
                                        const Eigen::Vector3d& object_center_camera) {
   for (std::size_t p = 0; p < scene.occluder_windows.size(); ++p) {
@@ -403,16 +404,18 @@ std::optional<kct::Pose> occluder_pose(const Scene& scene, double frame_time,
     const Eigen::Vector3d across(std::cos(angle), std::sin(angle), 0.0);
     const Eigen::Vector3d along(-across.y(), across.x(), 0.0);
     const double depth = object_center_camera.z() - scene.object_radius_m - scene.occluder_radius_m - 0.03;
+    const double scale = depth / object_center_camera.z();
+    // Offset of the occluder's axis from the object's centre (seen from the camera), metres
+    // at the object's distance: out of the object's way at the ends, one occluder radius at
+    // the peak (its edge on the object's centre).
     const double reach = scene.object_radius_m + scene.occluder_radius_m + 0.02;
-    const Eigen::Vector3d center = object_center_camera * (depth / object_center_camera.z()) +
-                                   (2.0 * progress - 1.0) * reach * across * (depth / object_center_camera.z()) +
-                                   0.25 * scene.object_radius_m * along;
+    const double offset = reach - (reach - scene.occluder_radius_m / scale) * std::sin(M_PI * progress);
     kct::Pose pose = kct::Pose::Identity();
-    // Cylinder axis (z) along `along`, tilted 20 deg towards the camera.
+    // Cylinder axis (z) along `along`, slightly tilted towards the camera.
     pose.linear() = Eigen::Quaterniond::FromTwoVectors(
-                        Eigen::Vector3d::UnitZ(), (along + Eigen::Vector3d(0, 0, -0.35)).normalized())
+                        Eigen::Vector3d::UnitZ(), (along + Eigen::Vector3d(0, 0, -0.15)).normalized())
                         .toRotationMatrix();
-    pose.translation() = center;
+    pose.translation() = (object_center_camera + offset * across) * scale;
     return pose;
   }
   return std::nullopt;
