@@ -1,13 +1,22 @@
 #!/usr/bin/env python3
-"""OPT-style benchmark driver (called by scripts/benchmark.sh, which installs, builds and
-sources the workspace first). Generates the missing models and sequences under
-data/benchmark (cached; deterministic from seeds), tracks every sequence with each preset,
-and writes docs/benchmarks.md with the AUC tables (like the paper's Tables 1-3), the frame
-times and PNG success curves in docs/benchmarks/. Python standard library only.
+"""Benchmark driver (called by scripts/benchmark.sh, which installs, builds and sources the
+workspace first). Three sections:
+
+  hard  hand-held motion (up to 30 mm and 8 deg a frame), clutter with distractors of the
+        object's own appearance, untextured and open objects, highlights and cast shadows,
+        lighting changes, a moving occluder, leaving the image, motion blur over the shutter
+        time, defocus, noise and JPEG (rendered by generate_sequence's scene render).
+  real  ViSP's real test sequences from Debian's visp-images-data (cube, castel) scored
+        without ground truth (frames held, contour alignment: NOT AUC), and its simulated
+        Castle-simu with ground truth (AUC).
+  opt   the OPT-style synthetic suite (the paper's Sec. 4 groups and speeds).
+
+Generates what is missing under data/benchmark (cached; deterministic from seeds), tracks every
+sequence with each configuration (a preset, or a preset with parameter overrides) and writes
+one page fragment per section (docs/benchmarks/<section>.md), docs/benchmarks.md (all of
+them) and the PNG success curves in docs/benchmarks/. Python standard library only.
 """
 import argparse
-import shutil
-import tempfile
 import datetime
 import json
 import os
@@ -18,12 +27,27 @@ import sys
 import time
 import zlib
 
+PHOTOS = "/usr/share/doc/opencv-doc/examples/data"
+VISP = "/usr/share/visp-images-data/ViSP-images"
+SECTIONS = ["hard", "real", "opt"]  # page order: the hard section first
+
+# ---------------------------------------------------------------------------------------------
+# Configurations: a label, a preset and parameter overrides. Add a cue ablation by appending to
+# ABLATIONS (it runs only when its preset exists), or on the command line with --variant.
+# ---------------------------------------------------------------------------------------------
+DEFAULT_PRESETS = ["realtime", "paper", "klt_only"]  # those that exist in the build are run
+ABLATIONS = [
+    # ("realtime_no_region", "realtime", {"region_weight": "0"}),  # label, preset, --param overrides
+]
+
+# ---------------------------------------------------------------------------------------------
+# OPT-style section
+# ---------------------------------------------------------------------------------------------
 GROUPS_SPEED = ["xy", "z", "inplane", "outofplane"]
 GROUPS_SINGLE = ["flash", "movinglight", "free"]
 GROUP_TITLES = {"xy": "x-y translation", "z": "z translation", "inplane": "in-plane rotation",
                 "outofplane": "out-of-plane rotation", "flash": "flash light",
                 "movinglight": "moving light", "free": "free motion"}
-PHOTOS = "/usr/share/doc/opencv-doc/examples/data"
 BACKGROUNDS = ["home.jpg", "aero3.jpg", "leuvenB.jpg", "graf3.png", "basketball1.png",
                "box_in_scene.png", "rubberwhale1.png", "licenseplate_motion.jpg"]
 # Benchmark objects: model name, resolution, focal length (px; same field of view at both
@@ -42,108 +66,105 @@ QUICK_FRAMES = int(os.environ.get("KCT_BENCH_QUICK_FRAMES", "30"))  # override o
 MOTION_BLUR_SAMPLES = 4
 NOISE_SIGMA = 2.0
 
+# ---------------------------------------------------------------------------------------------
+# Hard section
+# ---------------------------------------------------------------------------------------------
+HARD_FRAMES = 80
+HARD_OBJECTS = {
+    # model, whether it is textured, extra render options
+    "can": dict(model="can", kind="textured", render=["--smooth-shading"]),
+    "chest": dict(model="chest", kind="textured", render=[]),
+    "toy": dict(model="toy", kind="untextured", render=["--smooth-shading"]),
+    "castle": dict(model="castle", kind="untextured, open mesh", render=[]),
+}
+# Every hard sequence: hand-held motion, highlights, cast shadows, 1/60 s shutter at 30 fps,
+# noise and JPEG; each condition adds its difficulty.
+HARD_BASE = ["--trajectory", "handheld", "--typical-translation-mm", "5", "--typical-rotation-deg", "1.5",
+             "--jerk-probability", "0.05", "--specular", "0.4", "--shininess", "40", "--shadows",
+             "--shutter-fraction", "0.5", "--motion-blur-samples", "6", "--noise-sigma", "3",
+             "--jpeg-quality", "85"]
+HARD_CONDITIONS = {
+    "handheld": ("hand-held", []),
+    "clutter": ("clutter + own-colour distractors", ["--distractors", "3"]),
+    "occlusion": ("moving occluder", ["--occluder-passes", "2"]),
+    "leave": ("leaves and re-enters", ["--leave-start", "25", "--leave-frames", "14"]),
+    "lighting": ("lighting changes", ["--lighting-changes"]),
+    "sensor": ("blur, defocus, noise, JPEG", ["--shutter-fraction", "1.0", "--defocus-px", "2",
+                                              "--noise-sigma", "7", "--jpeg-quality", "35"]),
+}
+HARD_BACKGROUNDS = {"clutter": ["box_in_scene.png", "stuff.jpg", "fruits.jpg", "pic3.png"]}
+HARD_QUICK = dict(objects=["can", "toy"], conditions=["handheld", "clutter", "occlusion"], frames=40)
+HARD_MIN_VISIBLE = 0.1  # frames where less of the object is seen are not scored
+# Frames of each hard sequence tracked per preset (slow presets get the first N only).
+HARD_TRACK_FRAMES = {"paper": 80}
+
+# ---------------------------------------------------------------------------------------------
+# Real section: ViSP's sequences (Debian visp-images-data)
+# ---------------------------------------------------------------------------------------------
+REAL = {
+    "cube": dict(title="mbt/cube: real, 218 frames, cube held in hand",
+                 images=VISP + "/mbt/cube", prefix="image", xml=VISP + "/mbt/cube.xml",
+                 pose=VISP + "/mbt/cube.0.pos", model=VISP + "/mbt/cube.cao"),
+    "castel": dict(title="mbt-depth/castel: real, 30 frames, open low-poly castle",
+                   images=VISP + "/mbt-depth/castel/castel", prefix="image_",
+                   xml=VISP + "/mbt-depth/castel/chateau.xml",
+                   pose=VISP + "/mbt-depth/castel/chateau.0.pos",
+                   model=VISP + "/mbt-depth/castel/chateau.cao"),
+    "castle_simu": dict(title="mbt-depth/Castle-simu: simulated, 40 frames, ground truth",
+                        images=VISP + "/mbt-depth/Castle-simu/Images", prefix="Image_",
+                        xml=VISP + "/mbt-depth/Castle-simu/Config/chateau.xml",
+                        poses=VISP + "/mbt-depth/Castle-simu/CameraPose",
+                        model=VISP + "/mbt-depth/Castle-simu/Models/chateau.cao"),
+}
+REAL_QUICK = ["castel", "castle_simu"]
+
 
 def log(msg):
     print("[%s] %s" % (time.strftime("%H:%M:%S"), msg), file=sys.stderr, flush=True)
 
 
-def all_sequences():
-    return [(g, s) for g in GROUPS_SPEED for s in range(1, 6)] + [(g, 3) for g in GROUPS_SINGLE]
+def rosrun(tool, *args, **kw):
+    return subprocess.run(["rosrun", "klt_contour_tracker", tool] + [str(a) for a in args], **kw)
 
 
-def seq_name(group, speed):
-    return "%s_s%d" % (group, speed) if group in GROUPS_SPEED else group
+def cached_run(cmd, folder, what):
+    """Runs cmd unless folder/generated_by.txt records the same command (then the data is
+    cached)."""
+    stamp = os.path.join(folder, "generated_by.txt")
+    wanted = " ".join(shlex.quote(str(c)) for c in cmd) + "\n"
+    if os.path.exists(stamp) and open(stamp).read() == wanted:
+        return folder
+    log("data: %s" % what)
+    subprocess.run([str(c) for c in cmd], check=True, stdout=subprocess.DEVNULL)
+    with open(stamp, "w") as f:
+        f.write(wanted)
+    return folder
 
 
 def ensure_model(data, model):
     path = os.path.join(data, "models", model + ".obj")
     if not os.path.exists(path):
         log("models: generating %s" % model)
-        subprocess.run(["rosrun", "klt_contour_tracker", "make_benchmark_models", "--output-dir",
-                        os.path.join(data, "models"), "--only", model], check=True)
+        rosrun("make_benchmark_models", "--output-dir", os.path.join(data, "models"), "--only", model,
+               check=True)
     return path
 
 
-def ensure_sequence(data, obj, group, speed):
-    spec = OBJECTS[obj]
-    folder = os.path.join(data, "sequences", obj, seq_name(group, speed))
-    seed = zlib.crc32(("%s/%s/%d" % (obj, group, speed)).encode()) % 100000 + 1
-    background = os.path.join(PHOTOS, BACKGROUNDS[seed % len(BACKGROUNDS)])
-    cmd = ["rosrun", "klt_contour_tracker", "generate_sequence",
-           "--model", ensure_model(data, spec["model"]), "--output-dir", folder,
-           "--frames", str(spec["frames"]), "--width", str(spec["width"]),
-           "--height", str(spec["height"]), "--fx", str(spec["fx"]), "--motion", group,
-           "--speed", str(speed), "--seed", str(seed), "--noise-sigma", str(NOISE_SIGMA),
-           "--motion-blur-samples", str(MOTION_BLUR_SAMPLES), "--background", background]
-    stamp = os.path.join(folder, "generated_by.txt")
-    wanted = " ".join(shlex.quote(c) for c in cmd) + "\n"
-    if os.path.exists(stamp) and open(stamp).read() == wanted:
-        return folder
-    log("sequences: rendering %s/%s" % (obj, seq_name(group, speed)))
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    with open(stamp, "w") as f:
-        f.write(wanted)
-    return folder
-
-
-def track(data, results, obj, group, speed, preset, max_frames, repo):
-    spec = OBJECTS[obj]
-    folder = ensure_sequence(data, obj, group, speed)
-    out = os.path.join(results, preset, obj)
-    os.makedirs(out, exist_ok=True)
-    base = os.path.join(out, seq_name(group, speed))
-    cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder,
-           "--model", os.path.join(data, "models", spec["model"] + ".obj"), "--preset", preset,
-           "--param", "visibility_cache_dir=" + os.path.join(repo, "data", "cache", "visibility"),
-           "--output", base + ".poses.txt", "--summary-json", base + ".json",
-           "--errors", base + ".errors.txt", "--max-frames", str(max_frames), "--quiet"]
-    t0 = time.time()
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if proc.returncode != 0:
-        log("FAILED %s %s/%s: %s" % (preset, obj, seq_name(group, speed), proc.stderr.strip()[-300:]))
+def auc(errors, diameter):
+    """The paper's AUC (Sec. 4.1), as kct::auc_score: k in [0, 0.2] of the diameter, of 20."""
+    if not errors:
         return None
-    with open(base + ".json") as f:
-        summary = json.load(f)
-    with open(base + ".errors.txt") as f:
-        summary["normalized_errors"] = [float(x) / summary["diameter_m"] for x in f.read().split()]
-    summary.update(object=obj, group=group, speed=speed, wall_s=time.time() - t0)
-    log("%-9s %-10s %-14s AUC %5.2f  median %7.1f ms" % (preset, obj, seq_name(group, speed),
-                                                         summary["auc"], summary["median_ms"]))
-    return summary
-
-
-def startup_times(data, obj, preset, tmp):
-    """Wall time of a 2-frame track_sequence run (mesh load, visibility table, first frames) with
-    an empty visibility cache, then again with the cache it wrote: (first, cached) seconds."""
-    spec = OBJECTS[obj]
-    folder = ensure_sequence(data, obj, *all_sequences()[0])
-    cache = tempfile.mkdtemp(prefix="kct_startup_", dir=tmp)
-    times = []
-    for _ in range(2):
-        cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder,
-               "--model", os.path.join(data, "models", spec["model"] + ".obj"), "--preset", preset,
-               "--param", "visibility_cache_dir=" + cache, "--max-frames", "2", "--quiet"]
-        t0 = time.time()
-        proc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        times.append(time.time() - t0 if proc.returncode == 0 else None)
-    shutil.rmtree(cache, ignore_errors=True)
-    log("startup   %-10s %-9s first %s s, cached %s s" % (obj, preset, fmt(times[0], 1), fmt(times[1], 1)))
-    return times
-
-
-STAGES = [("klt", "KLT"), ("pnp", "PnP"), ("keypoint_detection", "keypoint detection"),
-          ("image", "image (pyramid, gradients)"), ("contour_extraction", "contour extraction"),
-          ("energy", "energy (cues)"), ("optimizer", "optimizer")]
+    return 100.0 * sum(max(0.0, 0.2 - e / diameter) for e in errors) / len(errors)
 
 
 def weighted_auc(rows):
-    """AUC over all frames of `rows` (the AUC is a per-frame mean, so this is exact)."""
-    n = sum(r["scored_frames"] for r in rows)
-    return sum(r["auc"] * r["scored_frames"] for r in rows) / n if n else None
+    """AUC over all scored frames of `rows` (the AUC is a per-frame mean, so this is exact)."""
+    n = sum(r["scored_frames"] for r in rows if r.get("auc") is not None)
+    return sum(r["auc"] * r["scored_frames"] for r in rows if r.get("auc") is not None) / n if n else None
 
 
 def median(values):
-    v = sorted(values)
+    v = sorted(x for x in values if x is not None)
     if not v:
         return None
     m = len(v) // 2
@@ -179,37 +200,6 @@ def machine():
     return "%s, %d logical cores (nproc), %s" % (cpu, os.cpu_count(), platform.platform())
 
 
-README_BEGIN = "<!-- benchmark headline: written by scripts/benchmark.sh -->"
-README_END = "<!-- end of benchmark headline -->"
-
-
-def update_readme(repo, page):
-    """Copies the page's per-object AUC table and run line into README.md's marked block."""
-    readme = os.path.join(repo, "README.md")
-    text = open(readme).read()
-    if README_BEGIN not in text or README_END not in text:
-        return
-    lines = page.splitlines()
-    table = []
-    i = lines.index(next(l for l in lines if l.startswith("## AUC per object")))
-    for l in lines[i + 1:]:
-        if l.startswith("|"):
-            table.append(l)
-        elif table:
-            break
-    info = dict((l.split(":**")[0][4:], l.split(":**", 1)[1].strip()) for l in lines if l.startswith("- **") and ":**" in l)
-    block = [README_BEGIN, "",
-             "Latest results: %s run (%s), %s, %s. AUC of 20, higher is better; all tables, "
-             "timings and plots in [docs/benchmarks.md](docs/benchmarks.md)." % (
-                 info.get("Mode", "?").split(" ")[0], info.get("Mode", "?").split(" ", 1)[-1].strip("()"),
-                 info.get("Date", "?"), info.get("Machine", "?").split(",")[0]),
-             ""] + table + ["", "![success curves](docs/benchmarks/overall.png)", "", README_END]
-    start = text.index(README_BEGIN)
-    end = text.index(README_END) + len(README_END)
-    with open(readme, "w") as f:
-        f.write(text[:start] + "\n".join(block) + text[end:])
-
-
 def code_version(repo):
     """KCT_BENCH_CODE when set (e.g. a snapshot built elsewhere), else the repo's HEAD."""
     if os.environ.get("KCT_BENCH_CODE"):
@@ -224,74 +214,434 @@ def code_version(repo):
     return "commit %s%s" % (commit, " (with uncommitted changes)" if dirty else "")
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--preset", action="append", dest="presets")
-    ap.add_argument("--objects", help="comma-separated subset of " + ",".join(OBJECTS))
-    ap.add_argument("--frames", type=int, help="frames per sequence for every object (generated and tracked)")
-    ap.add_argument("--track-frames", type=int,
-                    help="track only the first N frames of each sequence (no regeneration)")
-    ap.add_argument("--repo", required=True)
-    ap.add_argument("--command", required=True, help="the command line, for the report")
-    args = ap.parse_args()
-    presets = args.presets or ["realtime", "paper", "klt_only"]
-    repo = args.repo
-    # Taken now, before anything runs: the code the binaries were built from, not whatever
-    # HEAD is when the run ends (commits may land during a long run).
-    os.environ.setdefault("KCT_BENCH_CODE", code_version(repo))
-    data = os.path.join(os.environ.get("KCT_DATA", os.path.join(repo, "data")), "benchmark")
-    results = os.path.join(data, "results")
-    docs = os.path.join(repo, "docs")
-    plots = os.path.join(docs, "benchmarks")
-    tmp = os.path.join(data, "tmp")
-    for d in (results, plots, tmp):
-        os.makedirs(d, exist_ok=True)
+def available_presets():
+    """The presets track_sequence knows (its usage lists them)."""
+    proc = rosrun("track_sequence", "--help", capture_output=True, text=True)
+    for line in (proc.stdout + proc.stderr).splitlines():
+        if line.strip().startswith("presets:"):
+            return line.split(":", 1)[1].split()
+    return ["paper", "klt_only"]
 
+
+class Runner:
+    """Tracks a sequence with a configuration and returns the summary JSON (plus the per-frame
+    errors), or None when track_sequence failed."""
+
+    def __init__(self, repo, results):
+        self.repo, self.results = repo, results
+
+    def track(self, section, config, name, folder, model, max_frames=None, model_scale=None):
+        label, preset, params = config
+        out = os.path.join(self.results, section, label)
+        os.makedirs(out, exist_ok=True)
+        base = os.path.join(out, name.replace("/", "_"))
+        cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder, "--model", model,
+               "--preset", preset,
+               "--param", "visibility_cache_dir=" + os.path.join(self.repo, "data", "cache", "visibility"),
+               "--output", base + ".poses.txt", "--summary-json", base + ".json", "--quiet"]
+        with open(os.path.join(folder, "pose.txt")) as f:
+            if len([l for l in f if l.strip() and not l.startswith("#")]) > 1:  # ground truth
+                cmd += ["--errors", base + ".errors.txt"]
+        if model_scale:
+            cmd += ["--model-scale", str(model_scale)]
+        for k, v in sorted(params.items()):
+            cmd += ["--param", "%s=%s" % (k, v)]
+        if max_frames:
+            cmd += ["--max-frames", str(max_frames)]
+        t0 = time.time()
+        for f in (base + ".json", base + ".errors.txt"):
+            if os.path.exists(f):
+                os.remove(f)
+        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if proc.returncode != 0:
+            log("FAILED %s %s: %s" % (label, name, proc.stderr.strip()[-300:]))
+            return None
+        with open(base + ".json") as f:
+            summary = json.load(f)
+        summary["errors"] = []
+        if os.path.exists(base + ".errors.txt"):
+            with open(base + ".errors.txt") as f:
+                summary["errors"] = [float(x) for x in f.read().split()]
+        summary.update(preset=label, wall_s=time.time() - t0, poses_file=base + ".poses.txt")
+        return summary
+
+
+def header_lines(title, args, start, duration_s, gen_s, load_start, load_end, extra=()):
+    L = ["## %s\n" % title]
+    L.append("- **Command:** `%s`" % args.command)
+    L.append("- **Date:** %s" % start.strftime("%Y-%m-%d %H:%M UTC"))
+    L.append("- **Machine:** %s" % machine())
+    L.append("- **Code:** %s" % code_version(args.repo))
+    L.append("- **Duration of this section:** %.1f min (of which %.1f min generating missing data)" % (
+        duration_s / 60, gen_s / 60))
+    busy = max(load_start, load_end) > 0.5 * (os.cpu_count() or 1) + 0.5
+    L.append("- **Load average** (1 min) at start / end: %.2f / %.2f on %d cores.%s" % (
+        load_start, load_end, os.cpu_count(),
+        " The CPU was shared with other jobs: frame times are noisy and pessimistic." if busy else ""))
+    L.extend(extra)
+    L.append("")
+    return L
+
+
+def speed_table(rows, configs, key_rows):
+    """Median of the per-sequence median frame times (first frame excluded), ms."""
+    L = ["| object | faces | resolution | " + " | ".join(c[0] for c in configs) + " |",
+         "|---|---|---|" + "---|" * len(configs)]
+    for name, rr in key_rows:
+        if not rr:
+            continue
+        L.append("| %s | %d | %dx%d | %s |" % (name, rr[0]["faces"], rr[0]["width"], rr[0]["height"], " | ".join(
+            fmt(median([r["median_ms"] for r in rr if r["preset"] == c[0]]), 1) for c in configs)))
+    return L
+
+
+STAGES = [("klt", "KLT"), ("pnp", "PnP"), ("keypoint_detection", "keypoint detection"),
+          ("image", "image (pyramid, gradients)"), ("contour_extraction", "contour extraction"),
+          ("energy", "energy (cues)"), ("optimizer", "optimizer")]
+
+
+def stage_table(rows, configs, key_rows):
+    """Where the time goes (speed's table): median over the sequences of each stage's median, ms."""
+    staged = [c[0] for c in configs if any("stage_median_ms" in r for r in rows if r["preset"] == c[0])]
+    if not staged:
+        return []
+    L = ["Where the time goes: median over the sequences of each stage's median time per frame, ms. With "
+         "2 threads the refinement's image work runs while KLT does, so the stages may add up to more "
+         "than the frame time.\n",
+         "| preset | object | frame | " + " | ".join(t for _, t in STAGES) + " |",
+         "|---|---|---|" + "---|" * len(STAGES)]
+    for p in staged:
+        for name, rr in key_rows:
+            rr = [r for r in rr if r["preset"] == p and "stage_median_ms" in r]
+            if rr:
+                L.append("| %s | %s | %s | %s |" % (p, name, fmt(median([r["median_ms"] for r in rr]), 1), " | ".join(
+                    fmt(median([r["stage_median_ms"].get(k, 0.0) for r in rr]), 1) for k, _ in STAGES)))
+    return L + [""]
+
+
+def session_counts(rows):
+    """Loss / re-acquisition counts when track_sequence reports them (tracking session)."""
+    keys = sorted({k for r in rows for k, v in r.items()
+                   if isinstance(v, (int, float)) and not isinstance(v, bool)
+                   and any(w in k for w in ("lost", "loss", "reacquir", "recover"))})
+    return keys
+
+
+# ---------------------------------------------------------------------------------------------
+# Hard section
+# ---------------------------------------------------------------------------------------------
+def hard_sequence(data, obj, cond, frames):
+    spec = HARD_OBJECTS[obj]
+    seed = zlib.crc32(("hard/%s/%s" % (obj, cond)).encode()) % 100000 + 1
+    backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
+    folder = os.path.join(data, "hard", obj, cond)
+    cmd = ["rosrun", "klt_contour_tracker", "generate_sequence", "--model", ensure_model(data, spec["model"]),
+           "--output-dir", folder, "--frames", frames, "--seed", seed,
+           "--background", os.path.join(PHOTOS, backgrounds[seed % len(backgrounds)])]
+    cmd += HARD_BASE + spec["render"] + HARD_CONDITIONS[cond][1]
+    return cached_run(cmd, folder, "rendering hard/%s/%s" % (obj, cond))
+
+
+def run_hard(args, configs, runner, data, docs_dir, tmp):
+    objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
+    conditions = HARD_QUICK["conditions"] if args.quick else list(HARD_CONDITIONS)
+    frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or HARD_FRAMES)
+    start = datetime.datetime.now(datetime.timezone.utc)
+    load_start, t0 = os.getloadavg()[0], time.time()
+    folders = {(o, c): hard_sequence(data, o, c, frames) for o in objects for c in conditions}
+    gen_s = time.time() - t0
+    rows = []
+    for config in configs:
+        cap = HARD_TRACK_FRAMES.get(config[1])
+        for (o, c), folder in folders.items():
+            r = runner.track("hard", config, "%s/%s" % (o, c), folder,
+                             os.path.join(data, "models", HARD_OBJECTS[o]["model"] + ".obj"),
+                             max_frames=min(cap, frames) if cap else None)
+            if not r:
+                continue
+            visible = [float(l) for l in open(os.path.join(folder, "visible.txt")) if not l.startswith("#")]
+            scored = [e for e, v in zip(r["errors"], visible) if v >= HARD_MIN_VISIBLE]
+            r.update(object=o, condition=c, auc=auc(scored, r["diameter_m"]), scored_frames=len(scored),
+                     normalized_errors=[e / r["diameter_m"] for e in scored],
+                     visible_errors=[(e if v >= HARD_MIN_VISIBLE else None) for e, v in zip(r["errors"], visible)])
+            log("hard %-20s %-7s %-10s AUC %5.2f  median %7.1f ms" % (config[0], o, c, r["auc"] or 0, r["median_ms"]))
+            rows.append(r)
+    duration = time.time() - t0
+    load_end = os.getloadavg()[0]
+
+    def sel(**kw):
+        return [r for r in rows if all(r[k] == v for k, v in kw.items())]
+    labels = [c[0] for c in configs]
+    L = header_lines("Hard section", args, start, duration, gen_s, load_start, load_end, [
+        "- **Mode:** %s (%d objects x %d conditions x %d frames; tracked frames per sequence: %s)" % (
+            "quick" if args.quick else "full", len(objects), len(conditions), frames,
+            ", ".join("%s %d" % (c[0], min(HARD_TRACK_FRAMES.get(c[1], frames), frames)) for c in configs))])
+    L.append("Rendered by `generate_sequence`'s scene render (CPU rasterizer), 640x480, fx = 525 px, "
+             "30 fps. Every sequence: hand-held motion (a damped random walk of the velocity with random "
+             "jerks (5 % of the frames), at most 30 mm and 8 deg a frame; steady motion 5 mm and 1.5 deg per axis and frame "
+             "(standard deviation)), Blinn-Phong "
+             "highlights, cast shadows (shadow map) on the object, the distractors and the wall carrying "
+             "a real photograph, motion blur over a 1/60 s shutter (6 sub-frame renders along the "
+             "trajectory), Gaussian noise (sigma 3) and JPEG (quality 85). The conditions add:\n")
+    for c in conditions:
+        L.append("- `%s`: %s (`%s`)" % (c, HARD_CONDITIONS[c][0], " ".join(HARD_CONDITIONS[c][1]) or "nothing more"))
+    L.append("")
+    L.append("Objects: %s. AUC of 20 over the frames where at least %d %% of the object's silhouette is "
+             "in the image and not occluded (`visible.txt` of each sequence).\n" % (
+                 ", ".join("`%s` (%s)" % (o, HARD_OBJECTS[o]["kind"]) for o in objects), 100 * HARD_MIN_VISIBLE))
+    L.append("### AUC per condition\n")
+    L.append("| preset | " + " | ".join(conditions) + " | **all** |")
+    L.append("|---|" + "---|" * (len(conditions) + 1))
+    for p in labels:
+        L.append("| %s | %s | **%s** |" % (p, " | ".join(fmt(weighted_auc(sel(preset=p, condition=c))) for c in conditions),
+                                           fmt(weighted_auc(sel(preset=p)))))
+    L.append("")
+    caps = sorted({min(HARD_TRACK_FRAMES.get(c[1], frames), frames) for c in configs})
+    if len(caps) > 1:
+        n = caps[0]
+        L.append("Comparable with the presets tracked on fewer frames: every preset on the first %d frames "
+                 "of each sequence.\n" % n)
+        L.append("| preset | " + " | ".join(conditions) + " | **all** |")
+        L.append("|---|" + "---|" * (len(conditions) + 1))
+
+        def first_n(rr):
+            errs = [(e / r["diameter_m"]) for r in rr for e in r["visible_errors"][:n] if e is not None]
+            return auc(errs, 1.0)
+        for p in labels:
+            L.append("| %s | %s | **%s** |" % (p, " | ".join(fmt(first_n(sel(preset=p, condition=c))) for c in conditions),
+                                               fmt(first_n(sel(preset=p)))))
+        L.append("")
+    L.append("### AUC per object\n")
+    L.append("| preset | " + " | ".join(objects) + " |")
+    L.append("|---|" + "---|" * len(objects))
+    for p in labels:
+        L.append("| %s | %s |" % (p, " | ".join(fmt(weighted_auc(sel(preset=p, object=o))) for o in objects)))
+    L.append("")
+    L.append("### AUC per object and condition\n")
+    L.append("| preset | object | " + " | ".join(conditions) + " |")
+    L.append("|---|---|" + "---|" * len(conditions))
+    for p in labels:
+        for o in objects:
+            L.append("| %s | %s | %s |" % (p, o, " | ".join(fmt(weighted_auc(sel(preset=p, object=o, condition=c)))
+                                                              for c in conditions)))
+    L.append("")
+    keys = session_counts(rows)
+    if keys:
+        L.append("### Losses and re-acquisitions (tracking session)\n")
+        L.append("| preset | condition | " + " | ".join(keys) + " |")
+        L.append("|---|---|" + "---|" * len(keys))
+        for p in labels:
+            for c in conditions:
+                rr = sel(preset=p, condition=c)
+                L.append("| %s | %s | %s |" % (p, c, " | ".join(str(sum(int(r.get(k, 0)) for r in rr)) for k in keys)))
+        L.append("")
+    L.append("### Speed\n")
+    L.append("Median of the per-sequence median `track()` time per frame (first frame excluded), ms.\n")
+    L += speed_table(rows, configs, [(o, sel(object=o)) for o in objects])
+    L.append("")
+    L += stage_table(rows, configs, [(o, sel(object=o)) for o in objects])
+    for name in os.listdir(docs_dir):
+        if name.startswith("hard_") and name.endswith(".png"):
+            os.remove(os.path.join(docs_dir, name))
+    plot(os.path.join(docs_dir, "hard_overall.png"), "Hard section: success vs k",
+         [(p, [e for r in sel(preset=p) for e in r["normalized_errors"]]) for p in labels], tmp)
+    for c in conditions:
+        plot(os.path.join(docs_dir, "hard_%s.png" % c), "Hard: %s" % HARD_CONDITIONS[c][0],
+             [(p, [e for r in sel(preset=p, condition=c) for e in r["normalized_errors"]]) for p in labels], tmp)
+    L.append("### Success curves\n")
+    L.append("![hard section](benchmarks/hard_overall.png)\n")
+    L.append("Per condition: " + ", ".join("[%s](benchmarks/hard_%s.png)" % (c, c) for c in conditions) + ".\n")
+    return L, rows
+
+
+# ---------------------------------------------------------------------------------------------
+# Real section
+# ---------------------------------------------------------------------------------------------
+def real_sequence(data, name):
+    spec = REAL[name]
+    folder = os.path.join(data, "real", name)
+    cmd = ["rosrun", "klt_contour_tracker", "convert_visp_sequence", "--images", spec["images"],
+           "--prefix", spec["prefix"], "--camera-xml", spec["xml"], "--output-dir", folder]
+    cmd += ["--camera-poses", spec["poses"]] if "poses" in spec else ["--initial-pose", spec["pose"]]
+    return cached_run(cmd, folder, "converting ViSP sequence %s" % name)
+
+
+def alignment(folder, model, poses, out_base):
+    proc = rosrun("contour_alignment", "--sequence", folder, "--model", model, "--poses", poses,
+                  "--summary-json", out_base + ".alignment.json", "--per-frame", out_base + ".alignment.txt",
+                  capture_output=True, text=True)
+    if proc.returncode != 0:
+        log("contour_alignment failed on %s: %s" % (folder, proc.stderr.strip()[-300:]))
+        return None
+    return json.load(open(out_base + ".alignment.json"))
+
+
+def run_real(args, configs, runner, data, docs_dir, tmp):
+    if not os.path.isdir(VISP):
+        return ["## Real section\n", "Not run: %s is missing (Debian package visp-images-data).\n" % VISP], []
+    names = REAL_QUICK if args.quick else list(REAL)
+    start = datetime.datetime.now(datetime.timezone.utc)
+    load_start, t0 = os.getloadavg()[0], time.time()
+    folders = {n: real_sequence(data, n) for n in names}
+    gen_s = time.time() - t0
+    rows, reference = [], {}
+    for n in names:
+        folder = folders[n]
+        # References: the initial pose held still (what "no tracking" scores) and, with ground
+        # truth, the true poses.
+        pose_lines = [l for l in open(os.path.join(folder, "pose.txt")) if l.strip() and not l.startswith("#")]
+        frames = len([f for f in os.listdir(folder) if f.endswith(".png")])
+        frozen = os.path.join(tmp, "%s_frozen.txt" % n)
+        with open(frozen, "w") as f:
+            f.write(pose_lines[0] * frames)
+        base = os.path.join(tmp, n)
+        reference[n] = {"frozen": alignment(folder, REAL[n]["model"], frozen, base + "_frozen")}
+        if len(pose_lines) > 1:
+            reference[n]["truth"] = alignment(folder, REAL[n]["model"], os.path.join(folder, "pose.txt"), base + "_truth")
+    for config in configs:
+        for n in names:
+            r = runner.track("real", config, n, folders[n], REAL[n]["model"])
+            if not r:
+                continue
+            r.update(object=n, scored_frames=len(r["errors"]) if "auc" in r else 0)
+            if "auc" in r:
+                r["normalized_errors"] = [e / r["diameter_m"] for e in r["errors"]]
+            a = alignment(folders[n], REAL[n]["model"], r["poses_file"],
+                          os.path.join(runner.results, "real", config[0], n))
+            r["alignment"] = a
+            log("real %-20s %-12s held %s/%s  alignment %s%s" % (
+                config[0], n, a and a["held_frames"], a and a["frames"], fmt(a and a["alignment"], 3),
+                "  AUC %.2f" % r["auc"] if "auc" in r else ""))
+            rows.append(r)
+    duration = time.time() - t0
+    load_end = os.getloadavg()[0]
+    labels = [c[0] for c in configs]
+
+    def get(p, n):
+        return next((r for r in rows if r["preset"] == p and r["object"] == n), None)
+    L = header_lines("Real section", args, start, duration, gen_s, load_start, load_end,
+                     ["- **Mode:** %s (%s)" % ("quick" if args.quick else "full", ", ".join(names))])
+    L.append("ViSP's test sequences from the Debian package `visp-images-data` (`%s`), converted by "
+             "`convert_visp_sequence` (frames, K from the tracker's XML, ViSP's cMo = our "
+             "object_to_camera), tracked with ViSP's own `.cao` CAD models:\n" % VISP)
+    for n in names:
+        L.append("- `%s`: %s" % (n, REAL[n]["title"]))
+    L.append("")
+    L.append("**Where there is no ground truth the scores are NOT AUC.** `alignment` (`contour_alignment`): "
+             "the model's silhouette rendered at the tracked pose; the fraction of its outline pixels "
+             "within 2 px of a Canny edge of the frame (Gaussian sigma 1, thresholds 40/100), averaged "
+             "over the frames, 0..1. `chance` is the fraction of all pixels within 2 px of an edge (what "
+             "a randomly placed outline scores). `held` is the number of frames before the first 5 "
+             "consecutive frames whose alignment is below max(chance, half the first frame's). "
+             "`frozen` holds the initial pose for every frame (no tracking) and `truth` scores the "
+             "ground-truth poses where they exist.\n")
+    L.append("| sequence | frames | chance | frozen: held / alignment | truth: alignment | " +
+             " | ".join("%s: held / alignment" % p for p in labels) + " |")
+    L.append("|---|---|---|---|---|" + "---|" * len(labels))
+    for n in names:
+        fr = reference[n].get("frozen")
+        tr = reference[n].get("truth")
+        cells = []
+        for p in labels:
+            a = (get(p, n) or {}).get("alignment")
+            cells.append("%s / %s" % (a["held_frames"], fmt(a["alignment"], 3)) if a else "-")
+        L.append("| %s | %s | %s | %s | %s | %s |" % (
+            n, fr["frames"] if fr else "-", fmt(fr and fr["chance"], 3),
+            "%s / %s" % (fr["held_frames"], fmt(fr["alignment"], 3)) if fr else "-",
+            fmt(tr and tr["alignment"], 3), " | ".join(cells)))
+    L.append("")
+    gt = [n for n in names if any("auc" in r for r in rows if r["object"] == n)]
+    if gt:
+        L.append("With ground truth (AUC of 20, every frame):\n")
+        L.append("| sequence | " + " | ".join(labels) + " |")
+        L.append("|---|" + "---|" * len(labels))
+        for n in gt:
+            L.append("| %s | %s |" % (n, " | ".join(fmt((get(p, n) or {}).get("auc")) for p in labels)))
+        L.append("")
+    keys = session_counts(rows)
+    if keys:
+        L.append("Losses and re-acquisitions (tracking session):\n")
+        L.append("| preset | sequence | " + " | ".join(keys) + " |")
+        L.append("|---|---|" + "---|" * len(keys))
+        for p in labels:
+            for n in names:
+                r = get(p, n)
+                if r:
+                    L.append("| %s | %s | %s |" % (p, n, " | ".join(str(r.get(k, "-")) for k in keys)))
+        L.append("")
+    L.append("Speed (median `track()` time per frame, ms):\n")
+    L += speed_table(rows, configs, [(n, [r for r in rows if r["object"] == n]) for n in names])
+    L.append("")
+    for name in os.listdir(docs_dir):
+        if name.startswith("real_") and name.endswith(".png"):
+            os.remove(os.path.join(docs_dir, name))
+    if gt:
+        plot(os.path.join(docs_dir, "real_castle_simu.png"), "Castle-simu (ground truth): success vs k",
+             [(p, [e for r in rows if r["preset"] == p and r["object"] in gt for e in r.get("normalized_errors", [])])
+              for p in labels], tmp)
+        L.append("![Castle-simu](benchmarks/real_castle_simu.png)\n")
+    return L, rows
+
+
+# ---------------------------------------------------------------------------------------------
+# OPT-style section
+# ---------------------------------------------------------------------------------------------
+def all_opt_sequences():
+    return [(g, s) for g in GROUPS_SPEED for s in range(1, 6)] + [(g, 3) for g in GROUPS_SINGLE]
+
+
+def seq_name(group, speed):
+    return "%s_s%d" % (group, speed) if group in GROUPS_SPEED else group
+
+
+def opt_sequence(data, obj, group, speed):
+    spec = OBJECTS[obj]
+    folder = os.path.join(data, "sequences", obj, seq_name(group, speed))
+    seed = zlib.crc32(("%s/%s/%d" % (obj, group, speed)).encode()) % 100000 + 1
+    background = os.path.join(PHOTOS, BACKGROUNDS[seed % len(BACKGROUNDS)])
+    cmd = ["rosrun", "klt_contour_tracker", "generate_sequence",
+           "--model", ensure_model(data, spec["model"]), "--output-dir", folder,
+           "--frames", str(spec["frames"]), "--width", str(spec["width"]),
+           "--height", str(spec["height"]), "--fx", str(spec["fx"]), "--motion", group,
+           "--speed", str(speed), "--seed", str(seed), "--noise-sigma", str(NOISE_SIGMA),
+           "--motion-blur-samples", str(MOTION_BLUR_SAMPLES), "--background", background]
+    return cached_run(cmd, folder, "rendering %s/%s" % (obj, seq_name(group, speed)))
+
+
+def run_opt(args, configs, runner, data, docs_dir, tmp):
+    global QUICK_FRAMES
     if args.frames:
         for spec in OBJECTS.values():
             spec["frames"] = args.frames
-        global QUICK_FRAMES
         QUICK_FRAMES = min(QUICK_FRAMES, args.frames)
     objects = args.objects.split(",") if args.objects else (QUICK_OBJECTS if args.quick else list(OBJECTS))
     unknown = [o for o in objects if o not in OBJECTS]
     if unknown:
-        ap.error("unknown object(s) %s; known: %s" % (", ".join(unknown), ", ".join(OBJECTS)))
-    sequences = QUICK_SEQUENCES if args.quick else all_sequences()
+        sys.exit("unknown object(s) %s; known: %s" % (", ".join(unknown), ", ".join(OBJECTS)))
+    sequences = QUICK_SEQUENCES if args.quick else all_opt_sequences()
     start = datetime.datetime.now(datetime.timezone.utc)
-    load_start = os.getloadavg()
-    t0 = time.time()
-    # Generate everything first so that tracking times are not mixed with rendering.
-    for obj in objects:
-        for group, speed in sequences:
-            ensure_sequence(data, obj, group, speed)
+    load_start, t0 = os.getloadavg()[0], time.time()
+    folders = {(o, g, s): opt_sequence(data, o, g, s) for o in objects for g, s in sequences}
     gen_s = time.time() - t0
     rows = []
-    for preset in presets:
+    for config in configs:
         for obj in objects:
             frames = QUICK_FRAMES if args.quick else OBJECTS[obj]["frames"]
             if args.track_frames:
                 frames = min(frames, args.track_frames)
             for group, speed in sequences:
-                r = track(data, results, obj, group, speed, preset, frames, repo)
-                if r:
-                    r["preset"] = preset
-                    rows.append(r)
-    # Start-up of the default preset per model: first start (visibility table built) and cached.
-    startup = {}
-    if "realtime" in presets:
-        for obj in objects:
-            startup[obj] = startup_times(data, obj, "realtime", tmp)
-    total_s = time.time() - t0
-    load_end = os.getloadavg()
-
-    def growth(p):
-        vga = [(r0["faces"], median([r["median_ms"] for r in sel(preset=p, object=o)]))
-               for o in objects for r0 in sel(preset=p, object=o)[:1] if r0["width"] == 640]
-        if len(vga) < 2:
-            return "-"
-        small, large = min(vga), max(vga)
-        return "%.1fx (%d to %d faces)" % (large[1] / small[1], small[0], large[0]) if small[1] else "-"
+                r = runner.track("opt", config, "%s/%s" % (obj, seq_name(group, speed)), folders[(obj, group, speed)],
+                                 os.path.join(data, "models", OBJECTS[obj]["model"] + ".obj"), max_frames=frames)
+                if not r:
+                    continue
+                r.update(object=obj, group=group, speed=speed,
+                         normalized_errors=[e / r["diameter_m"] for e in r["errors"]])
+                log("opt  %-20s %-10s %-14s AUC %5.2f  median %7.1f ms" % (
+                    config[0], obj, seq_name(group, speed), r["auc"], r["median_ms"]))
+                rows.append(r)
+    duration = time.time() - t0
+    load_end = os.getloadavg()[0]
+    presets = [c[0] for c in configs]
 
     def sel(**kw):
         return [r for r in rows if all(
@@ -302,57 +652,37 @@ def main():
     slow = [s for s in speeds if s <= 2]
     fast = [s for s in speeds if s >= 4]
 
-    # Plots (stale ones from an earlier run with other objects or presets go first).
-    for name in os.listdir(plots):
-        if name.endswith(".png"):
-            os.remove(os.path.join(plots, name))
-    png = []
-    def add_plot(name, title, curves):
-        plot(os.path.join(plots, name), title, curves, tmp)
-        png.append(name)
-    add_plot("overall.png", "All sequences: success vs k", [
+    for name in os.listdir(docs_dir):
+        if name.endswith(".png") and (name == "overall.png" or name.startswith(("group_", "object_"))):
+            os.remove(os.path.join(docs_dir, name))
+    plot(os.path.join(docs_dir, "overall.png"), "OPT-style: success vs k", [
         ("%s %s" % (p, o), [e for r in sel(preset=p, object=o) for e in r["normalized_errors"]])
-        for p in presets for o in objects])
+        for p in presets for o in objects], tmp)
     for g in groups:
-        add_plot("group_%s.png" % g, GROUP_TITLES[g], [
+        plot(os.path.join(docs_dir, "group_%s.png" % g), GROUP_TITLES[g], [
             ("%s %s" % (p, o), [e for r in sel(preset=p, object=o, group=g) for e in r["normalized_errors"]])
-            for p in presets for o in objects])
+            for p in presets for o in objects], tmp)
     for o in objects:
         for p in presets:
-            add_plot("object_%s_%s.png" % (o, p), "%s, preset %s" % (o, p), [
+            plot(os.path.join(docs_dir, "object_%s_%s.png" % (o, p)), "%s, preset %s" % (o, p), [
                 (g, [e for r in sel(preset=p, object=o, group=g) for e in r["normalized_errors"]])
-                for g in groups])
+                for g in groups], tmp)
 
-    # Page.
     partial = args.track_frames or any(o not in objects for o in OBJECTS)
     mode = "quick" if args.quick else ("partial" if partial else "full")
-    L = []
-    L.append("# Benchmarks\n")
-    L.append("OPT-style synthetic benchmark (the paper's Sec. 4 evaluates on the OPT dataset, which "
-             "cannot be downloaded here). Generated by `scripts/benchmark.sh`; do not edit by hand.\n")
-    L.append("- **Mode:** %s (%d objects x %d sequences x %s frames, presets %s)" % (
+    extra = ["- **Mode:** %s (%d objects x %d sequences x %s frames)" % (
         mode, len(objects), len(sequences),
         str(QUICK_FRAMES if not args.track_frames else min(QUICK_FRAMES, args.track_frames)) if args.quick
-        else "/".join("%s %d" % (o, min(OBJECTS[o]["frames"], args.track_frames or 10**9)) for o in objects),
-        ", ".join(presets)))
+        else "/".join("%s %d" % (o, min(OBJECTS[o]["frames"], args.track_frames or 10**9)) for o in objects))]
     skipped = [o for o in OBJECTS if o not in objects]
     if skipped and not args.quick:
-        L.append("- **Not run here:** %s" % ", ".join(skipped))
-    L.append("- **Command:** `%s`" % args.command)
-    L.append("- **Date:** %s" % start.strftime("%Y-%m-%d %H:%M UTC"))
-    L.append("- **Machine:** %s" % machine())
-    L.append("- **Code:** %s" % code_version(repo))
-    L.append("- **Duration:** %.1f min (of which %.1f min generating missing data)" % (total_s / 60, gen_s / 60))
-    L.append("- **Load average** (1 min) at start / end: %.2f / %.2f on %d cores. %s" % (
-        load_start[0], load_end[0], os.cpu_count(),
-        "The CPU was shared with other jobs: frame times are noisy and pessimistic."
-        if max(load_start[0], load_end[0]) > 0.5 * (os.cpu_count() or 1) + 0.5 else ""))
-    L.append("")
-    L.append("AUC: area under the success curve (success rate in percent vs error threshold k, "
-             "k in [0, 0.2] of the object diameter), out of 20, as in the paper (Sec. 4.1). "
-             "Cells aggregate every frame of their sequences.\n")
-
-    L.append("## AUC per object (cf. the paper's Table 1)\n")
+        extra.append("- **Not run here:** %s" % ", ".join(skipped))
+    L = header_lines("OPT-style section", args, start, duration, gen_s, load_start, load_end, extra)
+    L.append("The paper's Sec. 4 evaluates on the OPT dataset, which cannot be downloaded here: these "
+             "sequences imitate its motion groups and speeds (moderate, clean shading, one photograph "
+             "as background: easy; the hard section is the harder test). Cells aggregate every frame "
+             "of their sequences.\n")
+    L.append("### AUC per object (cf. the paper's Table 1)\n")
     L.append("| object | faces | resolution | " + " | ".join(presets) + " |")
     L.append("|---|---|---|" + "---|" * len(presets))
     for o in objects:
@@ -363,8 +693,7 @@ def main():
                  " | ".join(fmt(weighted_auc(sel(preset=p, object=o))) for p in presets)))
     L.append("| **all** | | | %s |" % " | ".join("**%s**" % fmt(weighted_auc(sel(preset=p))) for p in presets))
     L.append("")
-
-    L.append("## AUC per motion group (cf. Table 2)\n")
+    L.append("### AUC per motion group (cf. Table 2)\n")
     L.append("| preset | object | " + " | ".join(GROUP_TITLES[g] for g in groups) + " |")
     L.append("|---|---|" + "---|" * len(groups))
     for p in presets:
@@ -373,12 +702,10 @@ def main():
             for g in groups:
                 rr = sel(preset=p, group=g) if o == "all" else sel(preset=p, object=o, group=g)
                 cells.append(fmt(weighted_auc(rr)))
-            name = "**all**" if o == "all" else o
-            L.append("| %s | %s | %s |" % (p, name, " | ".join(cells)))
+            L.append("| %s | %s | %s |" % (p, "**all**" if o == "all" else o, " | ".join(cells)))
     L.append("")
-
     if slow and fast:
-        L.append("## Slow vs fast motion (cf. Table 3)\n")
+        L.append("### Slow vs fast motion (cf. Table 3)\n")
         L.append("Translation and rotation groups only; slow = speed %s, fast = speed %s (of 1-5).\n" % (
             "/".join(map(str, slow)), "/".join(map(str, fast))))
         L.append("| preset | object | " + " | ".join("%s slow | %s fast" % (GROUP_TITLES[g], GROUP_TITLES[g])
@@ -395,59 +722,22 @@ def main():
                         cells.append(fmt(weighted_auc(rr)))
                 L.append("| %s | %s | %s |" % (p, "**all**" if o == "all" else o, " | ".join(cells)))
         L.append("")
-        if len(speeds) > 2:
-            L.append("### AUC per speed level (translation and rotation groups)\n")
-            L.append("| preset | object | " + " | ".join("speed %d" % s for s in speeds) + " |")
-            L.append("|---|---|" + "---|" * len(speeds))
-            for p in presets:
-                for o in objects:
-                    L.append("| %s | %s | %s |" % (p, o, " | ".join(
-                        fmt(weighted_auc(sel(preset=p, object=o, group=GROUPS_SPEED, speed=s))) for s in speeds)))
-            L.append("")
-
-    L.append("## Speed (cf. Table 4)\n")
+    L.append("### Speed (cf. Table 4)\n")
     L.append("Median of the per-sequence median tracking time per frame (first frame excluded), ms.\n")
-    L.append("| object | faces | resolution | " + " | ".join(presets) + " |")
-    L.append("|---|---|---|" + "---|" * len(presets))
-    for o in objects:
-        r0 = sel(object=o)
-        if not r0:
-            continue
-        L.append("| %s | %d | %dx%d | %s |" % (o, r0[0]["faces"], r0[0]["width"], r0[0]["height"],
-                 " | ".join(fmt(median([r["median_ms"] for r in sel(preset=p, object=o)]), 1) for p in presets)))
+    L += speed_table(rows, configs, [(o, sel(object=o)) for o in objects])
     L.append("")
 
+    def growth(p):
+        vga = [(r0["faces"], median([r["median_ms"] for r in sel(preset=p, object=o)]))
+               for o in objects for r0 in sel(preset=p, object=o)[:1] if r0["width"] == 640]
+        if len(vga) < 2:
+            return "-"
+        small, large = min(vga), max(vga)
+        return "%.1fx (%d to %d faces)" % (large[1] / small[1], small[0], large[0]) if small[1] else "-"
     L.append("Growth from the smallest to the largest mesh at 640x480 (the paper: 2.4x): " + ", ".join(
         "%s %s" % (p, growth(p)) for p in presets) + ".\n")
-
-    staged = [p for p in presets if any("stage_median_ms" in r for r in sel(preset=p))]
-    if staged:
-        L.append("### Where the time goes\n")
-        L.append("Median over the sequences of each stage's median time per frame, ms. With 2 threads the "
-                 "refinement's image work runs while KLT does, so the stages may add up to more than "
-                 "the frame time.\n")
-        L.append("| preset | object | frame | " + " | ".join(t for _, t in STAGES) + " |")
-        L.append("|---|---|---|" + "---|" * len(STAGES))
-        for p in staged:
-            for o in objects:
-                rr = [r for r in sel(preset=p, object=o) if "stage_median_ms" in r]
-                if rr:
-                    L.append("| %s | %s | %s | %s |" % (p, o, fmt(median([r["median_ms"] for r in rr]), 1), " | ".join(
-                        fmt(median([r["stage_median_ms"].get(k, 0.0) for r in rr]), 1) for k, _ in STAGES)))
-        L.append("")
-    if startup:
-        L.append("### Start-up (realtime)\n")
-        L.append("Wall time of a 2-frame `track_sequence` run: mesh load, visibility table, first frames; "
-                 "first with an empty visibility cache, then with the table it cached, s.\n")
-        L.append("| object | faces | first start | cached |")
-        L.append("|---|---|---|---|")
-        for o in objects:
-            r0 = sel(object=o)
-            L.append("| %s | %s | %s | %s |" % (o, r0[0]["faces"] if r0 else "-", fmt(startup[o][0], 1),
-                                              fmt(startup[o][1], 1)))
-        L.append("")
-
-    L.append("## Other metrics\n")
+    L += stage_table(rows, configs, [(o, sel(object=o)) for o in objects])
+    L.append("### Other metrics\n")
     L.append("| preset | object | success 5 cm / 5 deg | mean ADD, mm | extrapolated frames |")
     L.append("|---|---|---|---|---|")
     for p in presets:
@@ -459,41 +749,166 @@ def main():
             L.append("| %s | %s | %.3f | %.2f | %d of %d |" % (
                 p, o, sum(r["success_5cm5deg"] * r["scored_frames"] for r in rr) / n,
                 sum(r["mean_add_mm"] * r["scored_frames"] for r in rr) / n,
-                sum(r["extrapolated_frames"] for r in rr), sum(r["frames"] for r in rr)))
+                sum(r.get("extrapolated_frames", 0) for r in rr), sum(r["frames"] for r in rr)))
     failed = len(presets) * len(objects) * len(sequences) - len(rows)
     if failed:
         L.append("\n**%d tracking runs failed** (see the log of scripts/benchmark.sh)." % failed)
     L.append("")
-
-    L.append("## Success curves\n")
-    L.append("Success rate (percent of frames with error < k x diameter) vs k; the legend gives each "
-             "curve's AUC.\n")
+    L.append("### Success curves\n")
     L.append("![all sequences](benchmarks/overall.png)\n")
     L.append("Per motion group: " + ", ".join("[%s](benchmarks/group_%s.png)" % (GROUP_TITLES[g], g) for g in groups) + ".\n")
     L.append("Per object (curves per group): " + ", ".join(
         "[%s %s](benchmarks/object_%s_%s.png)" % (o, p, o, p) for o in objects for p in presets) + ".\n")
+    L.append("Objects (`make_benchmark_models`, see `models/README.md`): `can` (~2.5k faces), `chest` "
+             "(~4.7k), `rock` (~22k), `bike` (~150k); `can_1080p` is the can at 1920x1080 (same field of "
+             "view). Sequences (`generate_sequence`, 30 Hz): the four motion groups at speeds 1-5, flash "
+             "light, moving light and free motion (speed 3), over a real photograph, with %d-sample "
+             "motion blur and noise sigma %.0f; quick mode: %s, %s, %d frames each.\n" % (
+                 MOTION_BLUR_SAMPLES, NOISE_SIGMA, " and ".join(QUICK_OBJECTS),
+                 ", ".join(seq_name(g, s) for g, s in QUICK_SEQUENCES), QUICK_FRAMES))
+    return L, rows
 
-    L.append("## The suite\n")
-    L.append("""- **Objects** (`make_benchmark_models`, see `models/README.md`): `can` (soda-can-like
-  surface of revolution, ~2.5k faces), `chest` (box with barrel lid, bands, lock, ~4.7k), `rock`
-  (organic displaced icosphere, ~22k), `bike` (bicycle-like frame of many tubes, ~150k); `can_1080p`
-  is the can at OPT's 1920x1080 (same field of view). The paper's OPT objects have 2.6k to 176k faces.
-- **Sequences** (`generate_sequence`, 30 Hz): x-y translation, z translation, in-plane rotation and
-  out-of-plane rotation at speeds 1-5, flash light, moving light and free motion (speed 3), each over
-  a real photograph from opencv-doc, with %d-sample motion blur (averaged sub-frame renders) and
-  Gaussian sensor noise (sigma %.0f grey levels); seeded from the object, group and speed.
-- **Quick mode** (`--quick`): %s, %s, %d frames each.
-- Data are cached in `data/benchmark/` (git-ignored): delete it to regenerate.
-""" % (MOTION_BLUR_SAMPLES, NOISE_SIGMA, " and ".join(QUICK_OBJECTS),
-       ", ".join(seq_name(g, s) for g, s in QUICK_SEQUENCES), QUICK_FRAMES))
-    with open(os.path.join(docs, "benchmarks.md"), "w") as f:
+
+# ---------------------------------------------------------------------------------------------
+# The page and the README headline
+# ---------------------------------------------------------------------------------------------
+README_BEGIN = "<!-- benchmark headline: written by scripts/benchmark.sh -->"
+README_END = "<!-- end of benchmark headline -->"
+
+
+def first_table(lines, heading):
+    i = next((k for k, l in enumerate(lines) if l.startswith(heading)), None)
+    if i is None:
+        return []
+    table = []
+    for l in lines[i + 1:]:
+        if l.startswith("|"):
+            table.append(l)
+        elif table:
+            break
+    return table
+
+
+def write_page(repo, docs_dir):
+    fragments = {}
+    for s in SECTIONS:
+        path = os.path.join(docs_dir, "%s.md" % s)
+        if os.path.exists(path):
+            fragments[s] = open(path).read().rstrip("\n").splitlines()
+    L = ["# Benchmarks\n",
+         "Generated by `scripts/benchmark.sh`; do not edit by hand (each section is kept in "
+         "`docs/benchmarks/<section>.md` and re-written when that section is run). Sections: "
+         "[hard](#hard-section) (hand-held motion, clutter, untextured/open objects, occlusion, "
+         "leaving the image, lighting, sensor effects), [real](#real-section) (ViSP's real sequences: "
+         "frames held and contour alignment, not AUC, plus a simulated sequence with ground truth), "
+         "[OPT-style](#opt-style-section) (the paper's motion groups, easy).\n",
+         "AUC: area under the success curve (success rate in percent vs error threshold k, k in "
+         "[0, 0.2] of the object diameter), out of 20, as in the paper (Sec. 4.1). Each section "
+         "states its command, date, code version, duration and the machine's load.\n"]
+    for s in SECTIONS:
+        if s in fragments:
+            L += fragments[s] + [""]
+    with open(os.path.join(repo, "docs", "benchmarks.md"), "w") as f:
         f.write("\n".join(L) + "\n")
-    update_readme(repo, "\n".join(L))
-    with open(os.path.join(results, "rows_%s.json" % mode), "w") as f:
-        json.dump([{k: v for k, v in r.items() if k != "normalized_errors"} for r in rows], f, indent=1)
-    log("benchmark: wrote %s (%d runs, %.1f min)" % (os.path.join(docs, "benchmarks.md"), len(rows), total_s / 60))
-    for p in presets:
-        log("benchmark: overall AUC %s = %s" % (p, fmt(weighted_auc(sel(preset=p)))))
+    # README headline: the hard section's per-condition table first, then the OPT-style one.
+    readme = os.path.join(repo, "README.md")
+    text = open(readme).read()
+    if README_BEGIN not in text or README_END not in text:
+        return
+    block = [README_BEGIN, ""]
+    if "hard" in fragments:
+        block += ["**Hard section** (hand-held motion up to 30 mm / 8 deg a frame, clutter, untextured and "
+                  "open objects, occlusion, leaving the image, lighting, sensor effects), AUC of 20:", ""]
+        block += first_table(fragments["hard"], "### AUC per condition") + [""]
+        block += first_table(fragments["hard"], "### AUC per object") + [""]
+    if "opt" in fragments:
+        block += ["**OPT-style section** (the paper's motion groups; easy), AUC of 20:", ""]
+        block += first_table(fragments["opt"], "### AUC per object") + [""]
+    block += ["All tables (the real-footage section too), timings and plots: "
+              "[docs/benchmarks.md](docs/benchmarks.md).", ""]
+    if "hard" in fragments:
+        block += ["![hard section success curves](docs/benchmarks/hard_overall.png)", ""]
+    block.append(README_END)
+    start = text.index(README_BEGIN)
+    end = text.index(README_END) + len(README_END)
+    with open(readme, "w") as f:
+        f.write(text[:start] + "\n".join(block) + text[end:])
+
+
+def parse_variant(text):
+    """LABEL:PRESET[:name=value,name=value...]"""
+    parts = text.split(":", 2)
+    if len(parts) < 2 or not parts[0] or not parts[1]:
+        raise argparse.ArgumentTypeError("--variant takes LABEL:PRESET[:name=value,...], got %r" % text)
+    params = {}
+    if len(parts) == 3 and parts[2]:
+        for kv in parts[2].split(","):
+            if "=" not in kv:
+                raise argparse.ArgumentTypeError("--variant parameter %r is not name=value" % kv)
+            k, v = kv.split("=", 1)
+            params[k.strip()] = v.strip()
+    return (parts[0], parts[1], params)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--section", action="append", choices=SECTIONS, help="repeatable; default: all")
+    ap.add_argument("--quick", action="store_true", help="part of each section")
+    ap.add_argument("--preset", action="append", dest="presets", help="repeatable; default: %s and the "
+                    "ABLATIONS whose preset exists" % ", ".join(DEFAULT_PRESETS))
+    ap.add_argument("--variant", action="append", type=parse_variant, default=[],
+                    help="LABEL:PRESET:name=value,... a preset with parameter overrides (repeatable)")
+    ap.add_argument("--objects", help="OPT-style section: comma-separated subset of " + ",".join(OBJECTS))
+    ap.add_argument("--frames", type=int, help="OPT-style section: frames per sequence (generated and tracked)")
+    ap.add_argument("--track-frames", type=int, help="OPT-style section: track only the first N frames")
+    ap.add_argument("--hard-frames", type=int, help="hard section: frames per sequence [%d]" % HARD_FRAMES)
+    ap.add_argument("--repo", required=True)
+    ap.add_argument("--command", required=True, help="the command line, for the report")
+    args = ap.parse_args()
+    sections = [s for s in SECTIONS if s in (args.section or SECTIONS)]
+    known = available_presets()
+    if args.presets:
+        bad = [p for p in args.presets if p not in known]
+        if bad:
+            ap.error("unknown preset(s) %s; this build knows %s" % (", ".join(bad), ", ".join(known)))
+        configs = [(p, p, {}) for p in args.presets]
+    else:
+        configs = [(p, p, {}) for p in DEFAULT_PRESETS if p in known]
+        configs += [a for a in ABLATIONS if a[1] in known]
+    for v in args.variant:
+        if v[1] not in known:
+            ap.error("--variant %s: unknown preset %s" % (v[0], v[1]))
+        configs.append(v)
+    repo = args.repo
+    # Taken now, before anything runs: the code the binaries were built from, not whatever
+    # HEAD is when the run ends (commits may land during a long run).
+    os.environ.setdefault("KCT_BENCH_CODE", code_version(repo))
+    data = os.path.join(os.environ.get("KCT_DATA", os.path.join(repo, "data")), "benchmark")
+    results = os.path.join(data, "results")
+    docs_dir = os.path.join(repo, "docs", "benchmarks")
+    tmp = os.path.join(data, "tmp")
+    for d in (results, docs_dir, tmp):
+        os.makedirs(d, exist_ok=True)
+    log("benchmark: sections %s, configurations %s, load %.2f" % (
+        ", ".join(sections), ", ".join(c[0] for c in configs), os.getloadavg()[0]))
+    runner = Runner(repo, results)
+    t0 = time.time()
+    summary = []
+    for s in sections:
+        ts = time.time()
+        lines, rows = {"hard": run_hard, "real": run_real, "opt": run_opt}[s](args, configs, runner, data, docs_dir, tmp)
+        with open(os.path.join(docs_dir, "%s.md" % s), "w") as f:
+            f.write("\n".join(lines) + "\n")
+        with open(os.path.join(results, "rows_%s%s.json" % (s, "_quick" if args.quick else "")), "w") as f:
+            json.dump([{k: v for k, v in r.items() if k not in ("errors", "normalized_errors", "visible_errors")}
+                       for r in rows], f, indent=1)
+        for c in configs:
+            summary.append("%s %-22s AUC %s (%.1f min for the section)" % (
+                s, c[0], fmt(weighted_auc([r for r in rows if r["preset"] == c[0]])), (time.time() - ts) / 60))
+    write_page(repo, docs_dir)
+    log("benchmark: wrote docs/benchmarks.md (%.1f min, load at end %.2f)" % ((time.time() - t0) / 60, os.getloadavg()[0]))
+    for line in summary:
+        log("benchmark: " + line)
 
 
 if __name__ == "__main__":

@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
-# OPT-style benchmark: installs and builds (like demo.sh), generates the missing models and
-# sequences under data/benchmark (cached, deterministic), tracks them with each preset and
-# writes docs/benchmarks.md plus the success-curve PNGs in docs/benchmarks/.
-#   scripts/benchmark.sh [--quick] [--preset NAME ...] [--objects can,chest,...] [--frames N]
-#   --quick: can and chest, 11 sequences of 30 frames each (about 4 min on 2 cores)
-#   full run: can, chest, rock, bike, can_1080p x 23 sequences (60/60/60/12/40 frames):
-#             about 45 min on 2 idle cores; --frames N sets every object's sequence length,
-#             --track-frames N tracks only the first N frames (keeps the cached sequences)
-#   default presets: realtime, paper and klt_only (repeat --preset to choose)
+# Benchmark: installs and builds (like demo.sh), generates the missing models and sequences
+# under data/benchmark (cached, deterministic), tracks them with each configuration and writes
+# docs/benchmarks.md (+ docs/benchmarks/<section>.md and the success-curve PNGs).
+#   scripts/benchmark.sh [--section hard|real|opt ...] [--quick] [--preset NAME ...]
+#                        [--variant LABEL:PRESET:param=value,...] [--hard-frames N]
+#                        [--objects can,chest,...] [--frames N] [--track-frames N]
+#   sections (default: all): hard (hand-held, clutter, occlusion, leaving the image, lighting,
+#     sensor effects; 4 objects x 6 conditions x 80 frames), real (ViSP's sequences from
+#     visp-images-data), opt (OPT-style groups; --objects/--frames/--track-frames apply to it)
+#   --quick: part of each section; run times are in docs/benchmarks.md
+#   default configurations: the presets realtime, paper and klt_only that exist, plus the
+#     ABLATIONS listed in scripts/benchmark.py; --preset chooses presets (repeatable),
+#     --variant adds a preset with parameter overrides (repeatable)
 COMMAND="${KCT_WS:+KCT_WS=$KCT_WS }scripts/benchmark.sh $*"
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 ARGS=()
@@ -16,13 +20,19 @@ while [ $# -gt 0 ]; do
     --quick) ARGS+=(--quick); shift ;;
     --preset) [ $# -ge 2 ] || { echo "benchmark: --preset needs a name" >&2; exit 2; }
               ARGS+=(--preset "$2"); shift 2 ;;
+    --section) [ $# -ge 2 ] || { echo "benchmark: --section needs hard, real or opt" >&2; exit 2; }
+               ARGS+=(--section "$2"); shift 2 ;;
+    --variant) [ $# -ge 2 ] || { echo "benchmark: --variant needs LABEL:PRESET:param=value,..." >&2; exit 2; }
+               ARGS+=(--variant "$2"); shift 2 ;;
+    --hard-frames) [ $# -ge 2 ] || { echo "benchmark: --hard-frames needs a number" >&2; exit 2; }
+               ARGS+=(--hard-frames "$2"); shift 2 ;;
     --objects) [ $# -ge 2 ] || { echo "benchmark: --objects needs a list" >&2; exit 2; }
                ARGS+=(--objects "$2"); shift 2 ;;
     --frames) [ $# -ge 2 ] || { echo "benchmark: --frames needs a number" >&2; exit 2; }
               ARGS+=(--frames "$2"); shift 2 ;;
     --track-frames) [ $# -ge 2 ] || { echo "benchmark: --track-frames needs a number" >&2; exit 2; }
               ARGS+=(--track-frames "$2"); shift 2 ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "benchmark: unknown argument $1" >&2; exit 2 ;;
   esac
 done

@@ -702,7 +702,7 @@ int run_scene(const Options& o, std::shared_ptr<const kct::Mesh> mesh,
     poses.push_back(pose_at(i * frame_period));
     visible.push_back(visible_fraction(object_renderer, poses.back(), camera, ids));
   }
-  kct::write_pose_file(folder + "pose.txt", poses);
+  kct::write_pose_file(folder + "pose.txt", poses, kct::ModelUnits(o.model_scale));  // as the mesh
   std::ofstream vis(folder + "visible.txt");
   vis << "# fraction of the object's silhouette inside the image and not occluded, per frame\n";
   for (double v : visible) vis << v << "\n";

@@ -5,7 +5,7 @@
 ///   chest   (~4k faces)    a box with a barrel lid, metal bands and a lock
 ///   rock    (~20k faces)   an organic, smoothly displaced and elongated icosphere
 ///   bike    (~150k faces)  a bicycle-like frame: two torus wheels with spokes, many tubes
-///   toy     (~8k faces)    UNTEXTURED: a uniform-colour organic toy (a sitting bear-like figure
+///   toy     (~4.8k faces)    UNTEXTURED: a uniform-colour organic toy (a sitting bear-like figure
 ///                          of smooth blobs), shading only
 ///   castle  (18 faces)     UNTEXTURED and OPEN, like ViSP's castle CAD model: a floor polygon,
 ///                          a square tower of four walls and a front wall, no closing faces
@@ -281,13 +281,13 @@ void make_toy(Builder& b) {
       return Vector3d(radii.x() * r * d.x(), radii.y() * r * d.y(), radii.z() * r * d.z());
     });
   };
-  ellipsoid(4, {0.0, 0.0, 0.045}, {0.042, 0.036, 0.05}, 0.04);      // body
-  ellipsoid(4, {0.0, -0.006, 0.115}, {0.032, 0.03, 0.03}, 0.02);   // head
+  ellipsoid(3, {0.0, 0.0, 0.045}, {0.042, 0.036, 0.05}, 0.04);      // body
+  ellipsoid(3, {0.0, -0.006, 0.115}, {0.032, 0.03, 0.03}, 0.02);   // head
   ellipsoid(2, {0.0, -0.035, 0.108}, {0.012, 0.012, 0.01}, 0.0);   // snout
   for (double s : {-1.0, 1.0}) {
     ellipsoid(2, {0.022 * s, -0.002, 0.142}, {0.01, 0.006, 0.01}, 0.0);   // ears
-    ellipsoid(3, {0.045 * s, -0.01, 0.06}, {0.012, 0.013, 0.028}, 0.0);   // arms
-    ellipsoid(3, {0.024 * s, -0.03, 0.01}, {0.015, 0.028, 0.013}, 0.0);   // legs
+    ellipsoid(2, {0.045 * s, -0.01, 0.06}, {0.012, 0.013, 0.028}, 0.0);   // arms
+    ellipsoid(2, {0.024 * s, -0.03, 0.01}, {0.015, 0.028, 0.013}, 0.0);   // legs
   }
 }
 
