@@ -96,7 +96,7 @@ HARD_BACKGROUNDS = {"clutter": ["box_in_scene.png", "stuff.jpg", "fruits.jpg", "
 HARD_QUICK = dict(objects=["can", "toy"], conditions=["handheld", "clutter", "occlusion"], frames=40)
 HARD_MIN_VISIBLE = 0.1  # frames where less of the object is seen are not scored
 # Frames of each hard sequence tracked per preset (slow presets get the first N only).
-HARD_TRACK_FRAMES = {"paper": 80}
+HARD_TRACK_FRAMES = {"paper": 40}
 
 # ---------------------------------------------------------------------------------------------
 # Real section: ViSP's sequences (Debian visp-images-data)
@@ -227,8 +227,8 @@ class Runner:
     """Tracks a sequence with a configuration and returns the summary JSON (plus the per-frame
     errors), or None when track_sequence failed."""
 
-    def __init__(self, repo, results):
-        self.repo, self.results = repo, results
+    def __init__(self, repo, results, reuse=()):
+        self.repo, self.results, self.reuse = repo, results, set(reuse)
 
     def track(self, section, config, name, folder, model, max_frames=None, model_scale=None):
         label, preset, params = config
@@ -249,13 +249,19 @@ class Runner:
         if max_frames:
             cmd += ["--max-frames", str(max_frames)]
         t0 = time.time()
-        for f in (base + ".json", base + ".errors.txt"):
-            if os.path.exists(f):
-                os.remove(f)
-        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        if proc.returncode != 0:
-            log("FAILED %s %s: %s" % (label, name, proc.stderr.strip()[-300:]))
-            return None
+        if label in self.reuse and os.path.exists(base + ".json"):
+            pass  # --reuse: the previous run's result of this configuration
+        else:
+            for f in (base + ".json", base + ".errors.txt"):
+                if os.path.exists(f):
+                    os.remove(f)
+            proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            if proc.returncode != 0:
+                log("FAILED %s %s: %s" % (label, name, proc.stderr.strip()[-300:]))
+                return None
+            with open(os.path.join(out, "CODE"), "w") as f:  # for a later --reuse
+                f.write("%s, %s\n" % (os.environ.get("KCT_BENCH_CODE", "?"),
+                                      datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")))
         with open(base + ".json") as f:
             summary = json.load(f)
         summary["errors"] = []
@@ -278,6 +284,14 @@ def header_lines(title, args, start, duration_s, gen_s, load_start, load_end, ex
     L.append("- **Load average** (1 min) at start / end: %.2f / %.2f on %d cores.%s" % (
         load_start, load_end, os.cpu_count(),
         " The CPU was shared with other jobs: frame times are noisy and pessimistic." if busy else ""))
+    if args.reuse:
+        section = title.split()[0].lower().replace("opt-style", "opt")
+        origins = []
+        for label in args.reuse:
+            code = os.path.join(args.data_results, section, label, "CODE")
+            origins.append("%s (%s)" % (label, open(code).read().strip() if os.path.exists(code) else "?"))
+        L.append("- **Reused results** (`--reuse`: tracked by an earlier run; its code and date): %s"
+                 % "; ".join(origins))
     L.extend(extra)
     L.append("")
     return L
@@ -862,6 +876,9 @@ def main():
     ap.add_argument("--frames", type=int, help="OPT-style section: frames per sequence (generated and tracked)")
     ap.add_argument("--track-frames", type=int, help="OPT-style section: track only the first N frames")
     ap.add_argument("--hard-frames", type=int, help="hard section: frames per sequence [%d]" % HARD_FRAMES)
+    ap.add_argument("--reuse", action="append", default=[], metavar="LABEL",
+                    help="take this configuration's results from the previous run (data/benchmark/results) "
+                         "instead of tracking again, e.g. a slow preset whose code did not change (repeatable)")
     ap.add_argument("--repo", required=True)
     ap.add_argument("--command", required=True, help="the command line, for the report")
     args = ap.parse_args()
@@ -891,7 +908,8 @@ def main():
         os.makedirs(d, exist_ok=True)
     log("benchmark: sections %s, configurations %s, load %.2f" % (
         ", ".join(sections), ", ".join(c[0] for c in configs), os.getloadavg()[0]))
-    runner = Runner(repo, results)
+    args.data_results = results
+    runner = Runner(repo, results, args.reuse)
     t0 = time.time()
     summary = []
     for s in sections:

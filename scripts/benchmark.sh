@@ -3,7 +3,7 @@
 # under data/benchmark (cached, deterministic), tracks them with each configuration and writes
 # docs/benchmarks.md (+ docs/benchmarks/<section>.md and the success-curve PNGs).
 #   scripts/benchmark.sh [--section hard|real|opt ...] [--quick] [--preset NAME ...]
-#                        [--variant LABEL:PRESET:param=value,...] [--hard-frames N]
+#                        [--variant LABEL:PRESET:param=value,...] [--hard-frames N] [--reuse LABEL]
 #                        [--objects can,chest,...] [--frames N] [--track-frames N]
 #   sections (default: all): hard (hand-held, clutter, occlusion, leaving the image, lighting,
 #     sensor effects; 4 objects x 6 conditions x 80 frames), real (ViSP's sequences from
@@ -11,7 +11,8 @@
 #   --quick: part of each section; run times are in docs/benchmarks.md
 #   default configurations: the presets realtime, paper and klt_only that exist, plus the
 #     ABLATIONS listed in scripts/benchmark.py; --preset chooses presets (repeatable),
-#     --variant adds a preset with parameter overrides (repeatable)
+#     --variant adds a preset with parameter overrides (repeatable); --reuse LABEL takes that
+#     configuration's results from the previous run instead of tracking again
 COMMAND="${KCT_WS:+KCT_WS=$KCT_WS }scripts/benchmark.sh $*"
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 ARGS=()
@@ -24,6 +25,8 @@ while [ $# -gt 0 ]; do
                ARGS+=(--section "$2"); shift 2 ;;
     --variant) [ $# -ge 2 ] || { echo "benchmark: --variant needs LABEL:PRESET:param=value,..." >&2; exit 2; }
                ARGS+=(--variant "$2"); shift 2 ;;
+    --reuse) [ $# -ge 2 ] || { echo "benchmark: --reuse needs a configuration label" >&2; exit 2; }
+               ARGS+=(--reuse "$2"); shift 2 ;;
     --hard-frames) [ $# -ge 2 ] || { echo "benchmark: --hard-frames needs a number" >&2; exit 2; }
                ARGS+=(--hard-frames "$2"); shift 2 ;;
     --objects) [ $# -ge 2 ] || { echo "benchmark: --objects needs a list" >&2; exit 2; }
@@ -32,7 +35,7 @@ while [ $# -gt 0 ]; do
               ARGS+=(--frames "$2"); shift 2 ;;
     --track-frames) [ $# -ge 2 ] || { echo "benchmark: --track-frames needs a number" >&2; exit 2; }
               ARGS+=(--track-frames "$2"); shift 2 ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     *) echo "benchmark: unknown argument $1" >&2; exit 2 ;;
   esac
 done
