@@ -831,8 +831,11 @@ def write_page(repo, docs_dir):
         return
     block = [README_BEGIN, ""]
     if "hard" in fragments:
+        mode = next((l[len("- **Mode:** "):] for l in fragments["hard"] if l.startswith("- **Mode:**")), "")
+        date = next((l[len("- **Date:** "):] for l in fragments["hard"] if l.startswith("- **Date:**")), "")
         block += ["**Hard section** (hand-held motion up to 30 mm / 8 deg a frame, clutter, untextured and "
-                  "open objects, occlusion, leaving the image, lighting, sensor effects), AUC of 20:", ""]
+                  "open objects, occlusion, leaving the image, lighting, sensor effects), AUC of 20; %s, %s:"
+                  % (date, mode), ""]
         block += first_table(fragments["hard"], "### AUC per condition") + [""]
         block += first_table(fragments["hard"], "### AUC per object") + [""]
     if "opt" in fragments:
