@@ -48,6 +48,18 @@ bool refined_pose_agrees_with_keypoints(const KeypointResult& keypoints, const P
 KeypointTracker::KeypointTracker(std::shared_ptr<const Mesh> mesh, const TrackerParams& params)
     : mesh_(mesh), renderer_(mesh), params_(params) {}
 
+bool KeypointTracker::implausible_motion(const Pose& expected, const Pose& measured) const {
+  if (params_.keypoint_max_motion_deg > 0.0) {
+    const Eigen::AngleAxisd change(measured.linear() * expected.linear().transpose());
+    if (std::abs(change.angle()) * 180.0 / M_PI > params_.keypoint_max_motion_deg) return true;
+  }
+  if (params_.keypoint_max_motion_diameters > 0.0 && diameter_m_ > 0.0) {
+    const double moved_m = (measured * center_object_ - expected * center_object_).norm();
+    if (moved_m > params_.keypoint_max_motion_diameters * diameter_m_) return true;
+  }
+  return false;
+}
+
 void KeypointTracker::clear() {
   previous_gray_.release();
   previous_source_size_ = cv::Size();
@@ -329,7 +341,9 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   result.mean_reprojection_px = error_sum / inlier_image.size();
 
   const bool pose_ok = is_valid_pose(pose) && pose.translation().z() > 0;
-  result.success = pose_ok && result.inlier_ratio >= params_.klt_min_inlier_ratio;
+  result.implausible_motion = pose_ok && implausible_motion(object_to_camera_guess, pose);
+  result.success =
+      pose_ok && !result.implausible_motion && result.inlier_ratio >= params_.klt_min_inlier_ratio;
   if (result.success) {
     result.object_to_camera = pose;
     // Outliers are dropped so they do not pollute the next frame's RANSAC.

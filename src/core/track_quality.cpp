@@ -57,7 +57,8 @@ double TrackQualityMonitor::score(const TrackResult& result) const {
   return params_.energy_weight * e + (1.0 - params_.energy_weight) * k;
 }
 
-TrackState TrackQualityMonitor::update(const TrackResult& result) {
+TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvidence& color,
+                                       double color_lost_ratio) {
   if (result.status == TrackStatus::kInvalidInput) return state_;
   if (result.status == TrackStatus::kNotInitialized) {
     reset();
@@ -69,7 +70,22 @@ TrackState TrackQualityMonitor::update(const TrackResult& result) {
   }
   last_quality_ = score(result);
   last_good_ = last_quality_ >= params_.min_quality;
+  if (color.valid && result.status != TrackStatus::kInitialized) {
+    constexpr double kMinVisibleFraction = 0.1;  // the object cannot be tracked out of view
+    const bool out_of_view = color.visible_fraction < kMinVisibleFraction;
+    const bool faded = color.visible_fraction >= 0.3 && has_color_level_ && color_level_ > 0.0 &&
+                       color.contrast < color_lost_ratio * color_level_;
+    if (out_of_view || faded) {
+      last_good_ = false;
+      last_quality_ = std::min(last_quality_, params_.min_quality * 0.5);
+    }
+  }
   if (last_good_) {
+    if (color.valid && color.visible_fraction >= 0.3 && std::isfinite(color.contrast)) {
+      const double a = params_.energy_level_smoothing;
+      color_level_ = has_color_level_ ? (1.0 - a) * color_level_ + a * color.contrast : color.contrast;
+      has_color_level_ = true;
+    }
     last_good_pose_ = result.object_to_camera;
     if (result.refined && std::isfinite(result.energy_after)) {
       const double a = params_.energy_level_smoothing;
@@ -95,6 +111,8 @@ void TrackQualityMonitor::on_initialized(const Pose& object_to_camera) {
   last_good_pose_ = object_to_camera;
   energy_level_ = 0.0;
   has_energy_level_ = false;
+  color_level_ = 0.0;
+  has_color_level_ = false;
   bad_frames_ = good_frames_ = 0;
 }
 
@@ -103,6 +121,8 @@ void TrackQualityMonitor::reset() {
   bad_frames_ = good_frames_ = 0;
   energy_level_ = 0.0;
   has_energy_level_ = false;
+  color_level_ = 0.0;
+  has_color_level_ = false;
   last_good_ = false;
 }
 

@@ -37,6 +37,7 @@ Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
   center_object_ = mesh_->bounding_box_center();
   const std::string size_error = implausible_diameter(diameter_m_);
   if (!size_error.empty()) throw std::invalid_argument("Tracker: " + size_error);
+  keypoints_.set_object_extent(diameter_m_, center_object_);
   set_camera(camera);
   if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   configure_motion_model();

@@ -32,12 +32,15 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(ransac_reprojection_px), KCT_FIELD(ransac_iterations), KCT_FIELD(klt_min_points),
       KCT_FIELD(klt_min_inlier_ratio), KCT_FIELD(redetect_ratio), KCT_FIELD(redetect_interval_frames),
       KCT_FIELD(redetect_max_reprojection_increase_px),
+      KCT_FIELD(keypoint_max_motion_diameters), KCT_FIELD(keypoint_max_motion_deg),
       KCT_FIELD(keypoint_mask_erosion_px), KCT_FIELD(motion_model),
       KCT_FIELD(motion_velocity_smoothing), KCT_FIELD(motion_error_smoothing),
       KCT_FIELD(klt_predicted_flow), KCT_FIELD(keypoint_motion_gate_sigmas),
       KCT_FIELD(motion_prior_weight), KCT_FIELD(region_weight),
       KCT_FIELD(region_line_half_length_px), KCT_FIELD(region_line_spacing_px),
       KCT_FIELD(region_band_px), KCT_FIELD(region_learning_rate),
+      KCT_FIELD(color_search), KCT_FIELD(color_learn_interval_frames),
+      KCT_FIELD(color_lost_ratio), KCT_FIELD(color_accept_ratio),
       KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
       KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
       KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
@@ -119,7 +122,12 @@ void TrackerParams::validate() const {
   check_range("redetect_interval_frames", redetect_interval_frames, 0, 1000000);
   check_range("redetect_max_reprojection_increase_px", redetect_max_reprojection_increase_px, 0.0,
               1e6);
+  check_range("keypoint_max_motion_diameters", keypoint_max_motion_diameters, 0.0, 1e3);
+  check_range("keypoint_max_motion_deg", keypoint_max_motion_deg, 0.0, 180.0);
   check_range("keypoint_mask_erosion_px", keypoint_mask_erosion_px, 0, 100);
+  check_range("color_learn_interval_frames", color_learn_interval_frames, 1, 100000);
+  check_range("color_lost_ratio", color_lost_ratio, 0.0, 1.0);
+  check_range("color_accept_ratio", color_accept_ratio, 0.0, 1.0);
   check_range("motion_velocity_smoothing", motion_velocity_smoothing, 1e-6, 1.0);
   check_range("motion_error_smoothing", motion_error_smoothing, 1e-6, 1.0);
   check_range("keypoint_motion_gate_sigmas", keypoint_motion_gate_sigmas, 0.0, 1000.0);
@@ -177,6 +185,16 @@ TrackerParams make_preset(const std::string& name) {
     // 642 viewpoints instead of 2562: the visibility table of a 150k-face mesh builds 4x faster
     // (issue 10: <= 5 s on first start); same AUC on the bike (19.67 / 18.43 vs 19.57 / 18.40).
     params.icosphere_subdivisions = 3;
+    // A PnP pose more than 25 deg or half a diameter away from the last pose is a RANSAC
+    // failure on few keypoints, not hand-held motion (<= 8 deg / 30 mm a frame).
+    params.keypoint_max_motion_deg = 25.0;
+    params.keypoint_max_motion_diameters = 0.5;
+    params.color_search = true;
+    // Keypoints are re-anchored on the refined pose whenever they thin out, unless it moved the
+    // KLT inliers' mean reprojection error by more than 2 px (0.5 in `paper`): after a blurred
+    // frame or a re-acquisition the contour corrects the pose and the new anchors follow it
+    // (hard section: 9.89 -> 10.38 AUC).
+    params.redetect_max_reprojection_increase_px = 2.0;
     return params;
   }
   if (name == "klt_only") {

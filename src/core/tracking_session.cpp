@@ -22,6 +22,7 @@ void TrackingSession::set_camera(const PinholeCamera& camera) {
     tracker_ = std::make_unique<Tracker>(mesh_, camera, params_);
   else
     tracker_->set_camera(camera);
+  if (params_.color_search && !search_) search_ = std::make_unique<ObjectSearch>(mesh_);
 }
 
 const Tracker& TrackingSession::tracker() const {
@@ -33,6 +34,8 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   if (!tracker_) throw std::logic_error("TrackingSession::initialize: no camera yet (set_camera)");
   tracker_->initialize(object_to_camera);  // validates the pose
   monitor_.on_initialized(object_to_camera);
+  if (search_) search_->clear();  // a new track may be another scene
+  frames_since_learning_ = 0;
   initialized_since_last_frame_ = true;
   lost_at_frame_ = -1;
 }
@@ -48,14 +51,43 @@ void TrackingSession::set_params(const TrackerParams& params) {
   params.validate();
   if (tracker_) tracker_->set_params(params);
   params_ = params;
+  if (!params_.color_search)
+    search_.reset();
+  else if (!search_ && tracker_)
+    search_ = std::make_unique<ObjectSearch>(mesh_);
 }
 
 void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
   monitor_.set_params(quality);
 }
 
-TrackResult TrackingSession::reacquire(const Frame& frame) {
+TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched) {
+  searched = false;
+  if (search_ && search_->ready() && !bgr.empty() && monitor_.color_level() > 0.0) {
+    const std::vector<SearchCandidate> found =
+        search_->search(bgr, monitor_.last_good_pose(), tracker_->camera());
+    if (!found.empty() &&
+        found.front().contrast >= params_.color_accept_ratio * monitor_.color_level()) {
+      searched = true;
+      return tracker_->reacquire(frame, found.front().object_to_camera, 1.0);
+    }
+  }
   return tracker_->reacquire(frame, monitor_.last_good_pose(), monitor_.params().reacquire_search_scale);
+}
+
+void TrackingSession::use_colors(const cv::Mat& bgr, SessionResult& result) {
+  if (!search_ || bgr.empty() || !result.has_pose()) return;
+  const Pose& pose = result.frame.object_to_camera;
+  if (result.frame.status == TrackStatus::kInitialized) {
+    search_->learn(bgr, pose, tracker_->camera());
+    frames_since_learning_ = 0;
+    return;
+  }
+  if (!search_->ready()) return;
+  const SearchCandidate scored = search_->score(bgr, pose, tracker_->camera());
+  result.color.valid = true;
+  result.color.contrast = scored.contrast;
+  result.color.visible_fraction = scored.visible_fraction;
 }
 
 SessionResult TrackingSession::track(const Frame& frame) {
@@ -80,11 +112,24 @@ SessionResult TrackingSession::track(const Frame& frame) {
   initialized_since_last_frame_ = false;
 
   result.reacquiring = monitor_.should_reacquire();
-  result.frame = result.reacquiring ? reacquire(frame) : tracker_->track(frame);
-  result.state = monitor_.update(result.frame);
+  // The colour frame, when the colour model is on and the frame is in colour (checked first:
+  // an invalid frame is the tracker's to report).
+  cv::Mat bgr;
+  if (search_ && frame.image.type() == CV_8UC3 && frame.image.size() == tracker_->camera().size())
+    bgr = tracker_->undistorted_color(frame.image);
+  result.frame = result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
+  use_colors(bgr, result);
+  result.state = monitor_.update(result.frame, result.color, params_.color_lost_ratio);
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();
+    // Colours are learned on good frames while tracking, every color_learn_interval_frames.
+    if (search_ && !bgr.empty() && result.good && result.state == TrackState::kTracking &&
+        result.frame.status != TrackStatus::kInitialized &&
+        ++frames_since_learning_ >= params_.color_learn_interval_frames) {
+      search_->learn(bgr, result.frame.object_to_camera, tracker_->camera());
+      frames_since_learning_ = 0;
+    }
   }
   count(result);
   return result;

@@ -59,6 +59,39 @@ TEST_F(KeypointTrackerTest, RecoversAKnownMotionBetweenRenderedFrames) {
   EXPECT_LT(result.mean_reprojection_px, 0.5);
 }
 
+TEST_F(KeypointTrackerTest, RejectsAPnpPoseThatMovedImplausiblyFarFromTheExpectedOne) {
+  const Pose pose0 = test::make_pose(0.4);
+  const Pose pose1 = test::move(pose0, 3.0, {0.3, 1.0, 0.2}, {0.006, -0.004, 0.01});
+  const Eigen::Vector3d centre = mesh_->bounding_box_center();
+  const double diameter = mesh_->diameter();
+  // The same frames, but the caller expected the object 30 deg / 20 cm away from where the
+  // keypoints put it: with the bounds on, the PnP pose is not used.
+  const Pose far_expected = test::move(pose0, 30.0, {1.0, 0.0, 0.0}, {0.2, 0.0, 0.0});
+  for (const bool bounded : {false, true}) {
+    TrackerParams params = params_;
+    if (bounded) {
+      params.keypoint_max_motion_deg = 25.0;
+      params.keypoint_max_motion_diameters = 0.5;
+    }
+    KeypointTracker tracker(mesh_, params);
+    tracker.set_object_extent(diameter, centre);
+    ASSERT_GE(tracker.detect(gray_at(pose0, 1), pose0, camera_), 50);
+    const KeypointResult result = tracker.track(gray_at(pose1, 2), far_expected, camera_);
+    EXPECT_EQ(result.implausible_motion, bounded);
+    EXPECT_EQ(result.success, !bounded);
+  }
+  // Within the bounds (3 deg, ~1.3 cm): accepted as before.
+  TrackerParams params = params_;
+  params.keypoint_max_motion_deg = 25.0;
+  params.keypoint_max_motion_diameters = 0.5;
+  KeypointTracker tracker(mesh_, params);
+  tracker.set_object_extent(diameter, centre);
+  ASSERT_GE(tracker.detect(gray_at(pose0, 1), pose0, camera_), 50);
+  const KeypointResult result = tracker.track(gray_at(pose1, 2), pose0, camera_);
+  EXPECT_TRUE(result.success);
+  EXPECT_FALSE(result.implausible_motion);
+}
+
 TEST_F(KeypointTrackerTest, FailsWithoutTextureAndAsksForRedetection) {
   auto plain = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06, /*textured=*/false));
   Renderer renderer(plain);

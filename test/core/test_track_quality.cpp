@@ -57,6 +57,37 @@ TEST(TrackQuality, EnergyLevelIsAMovingAverageOfGoodFramesOnly) {
   EXPECT_DOUBLE_EQ(monitor.energy_level(), 15.0);
 }
 
+TEST(TrackQuality, ColourEvidenceMakesAFrameBadWhenTheOutlineStopsSeparatingTheColours) {
+  TrackQualityParams params;
+  params.energy_level_smoothing = 1.0;  // levels = the last good frame's
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  ColorEvidence color;
+  color.valid = true;
+  color.contrast = 0.8;
+  color.visible_fraction = 1.0;
+  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  EXPECT_TRUE(monitor.last_good());
+  EXPECT_DOUBLE_EQ(monitor.color_level(), 0.8);
+  // Energy and keypoints fine, contrast 0.3 < 0.4 x 0.8: bad, and the level stays.
+  color.contrast = 0.3;
+  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  EXPECT_FALSE(monitor.last_good());
+  EXPECT_DOUBLE_EQ(monitor.color_level(), 0.8);
+  // 0.33 > 0.32: good again.
+  color.contrast = 0.33;
+  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  EXPECT_TRUE(monitor.last_good());
+  // Less than 10 % of the object in the image: bad whatever the other cues say.
+  color.contrast = 0.8;
+  color.visible_fraction = 0.05;
+  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  EXPECT_FALSE(monitor.last_good());
+  // Without colour evidence (grey frames) nothing changes.
+  monitor.update(refined_result(10.0, true, 1.0), ColorEvidence{}, 0.4);
+  EXPECT_TRUE(monitor.last_good());
+}
+
 TEST(TrackQuality, LostAfterTheStatedBadFramesAndRecoversAfterTheStatedGoodFrames) {
   TrackQualityParams params;
   params.lost_after_bad_frames = 3;

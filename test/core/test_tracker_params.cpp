@@ -110,7 +110,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 56u);
+  EXPECT_EQ(fields.size(), 62u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -129,6 +129,20 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   bad = realtime;
   bad.num_threads = 0;
   EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.keypoint_max_motion_deg = 200.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.color_lost_ratio = 1.5;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.color_learn_interval_frames = 0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  // The session's colour model and the PnP motion bounds are ours: off in paper and klt_only.
+  EXPECT_TRUE(realtime.color_search);
+  EXPECT_FALSE(make_preset("paper").color_search);
+  EXPECT_FALSE(make_preset("klt_only").color_search);
+  EXPECT_EQ(make_preset("klt_only").keypoint_max_motion_deg, 0.0);
 }
 
 }  // namespace

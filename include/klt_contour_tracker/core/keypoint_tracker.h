@@ -31,6 +31,9 @@ struct KeypointResult {
   int inliers = 0;               ///< RANSAC inliers
   double inlier_ratio = 0.0;     ///< inliers / tracked
   double mean_reprojection_px = 0.0;  ///< mean reprojection error of the inliers at the PnP pose
+  /// The PnP pose moved implausibly far from the expected pose (keypoint_max_motion_*): not
+  /// used (success is false).
+  bool implausible_motion = false;
   KeypointInliers inlier_points;      ///< correspondences used by the search area
   double klt_ms = 0.0;  ///< wall time of the KLT tracking (normalization, pyramids, LK), ms
   double pnp_ms = 0.0;  ///< wall time of PnP + RANSAC + LM, ms
@@ -84,6 +87,12 @@ class KeypointTracker {
   const cv::Mat& object_mask() const { return object_mask_; }
   void clear();
   void set_params(const TrackerParams& params) { params_ = params; }
+  /// The object's diameter (metres) and bounding-box centre (object frame) for the motion
+  /// plausibility check (keypoint_max_motion_*); the owner computes them once per mesh.
+  void set_object_extent(double diameter_m, const Eigen::Vector3d& center_object) {
+    diameter_m_ = diameter_m;
+    center_object_ = center_object;
+  }
 
  private:
   /// The frame KLT tracks on: `gray` normalized to zero mean / unit variance over
@@ -93,6 +102,8 @@ class KeypointTracker {
   int downscale_steps(const cv::Size& size) const;
   /// `gray` halved `steps` times with cv::pyrDown (pixel u there is 2^steps u here).
   static cv::Mat downscale(const cv::Mat& gray, int steps);
+  /// True when `measured` moved farther from `expected` than keypoint_max_motion_* allow.
+  bool implausible_motion(const Pose& expected, const Pose& measured) const;
 
   std::shared_ptr<const Mesh> mesh_;
   Renderer renderer_;
@@ -104,6 +115,8 @@ class KeypointTracker {
   cv::Mat object_mask_;  ///< silhouette rendered by the last detect() (KLT frame's size)
   std::vector<cv::Point2f> image_points_;
   std::vector<cv::Point3f> object_points_;
+  double diameter_m_ = 0.0;                                  ///< mesh diameter, metres
+  Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();  ///< bounding-box centre
   int detected_count_ = 0;
 };
 

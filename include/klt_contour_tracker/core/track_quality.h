@@ -22,6 +22,13 @@ enum class TrackState {
 /// "waiting_for_pose", "tracking", "lost".
 const char* to_string(TrackState state);
 
+/// Colour evidence of a frame's pose (ObjectSearch::score()), when the session has a colour model.
+struct ColorEvidence {
+  bool valid = false;             ///< false: no colour model or a grey frame (ignored)
+  double contrast = 0.0;          ///< mean P(fg) inside the silhouette - in a ring around it
+  double visible_fraction = 1.0;  ///< share of the silhouette inside the image
+};
+
 /// Thresholds of the quality score and the state machine (all ours).
 struct TrackQualityParams {
   /// Weight of the energy cue in the score when the refinement ran; the KLT inlier ratio gets
@@ -59,8 +66,13 @@ class TrackQualityMonitor {
   double score(const TrackResult& result) const;
 
   /// Scores `result`, updates the energy level (good frames only), the last good pose and the
-  /// state. Returns the new state.
-  TrackState update(const TrackResult& result);
+  /// state. Returns the new state. With valid `color` evidence a frame is also bad when less
+  /// than 10 % of the object is in the image or its contrast is below `color_lost_ratio` x the
+  /// running contrast level of good frames.
+  TrackState update(const TrackResult& result, const ColorEvidence& color = {},
+                    double color_lost_ratio = 0.0);
+  /// Running colour contrast of good frames (0 when none yet).
+  double color_level() const { return color_level_; }
 
   /// A pose was given to the tracker: TRACKING, counters cleared, the energy level forgotten.
   void on_initialized(const Pose& object_to_camera);
@@ -91,6 +103,8 @@ class TrackQualityMonitor {
   Pose last_good_pose_ = Pose::Identity();
   double energy_level_ = 0.0;
   bool has_energy_level_ = false;
+  double color_level_ = 0.0;
+  bool has_color_level_ = false;
   double last_quality_ = 0.0;
   bool last_good_ = false;
   int bad_frames_ = 0;

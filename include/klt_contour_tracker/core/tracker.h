@@ -96,6 +96,10 @@ class Tracker {
   /// The refiner's contour extractor (with its visibility table), e.g. for drawing the model's
   /// contour; null when the refinement is off.
   const ContourExtractor* contour_extractor() const;
+  /// `image` in colour, undistorted as the pipeline sees it (CV_8UC3); empty for a grey image.
+  cv::Mat undistorted_color(const cv::Mat& image) const { return to_bgr(image); }
+  /// Mesh diameter, metres (computed once).
+  double diameter_m() const { return diameter_m_; }
   /// Last pose output (valid when is_initialized()).
   const Pose& last_pose() const { return pose_i1_; }
 

@@ -43,6 +43,13 @@ struct TrackerParams {
   /// that lands in a wrong optimum (the energy is nearly flat between some poses) then stays a
   /// one-frame error instead of being baked into the new anchors.
   double redetect_max_reprojection_increase_px = 0.5;
+  /// ours (0 = off, the paper): a PnP pose that moved the object's centre by more than this
+  /// many object diameters, or rotated it by more than keypoint_max_motion_deg, from the
+  /// expected pose (the motion model's prediction or the last pose) in one frame is not a
+  /// preliminary pose: KLT counts as failed (a few keypoints, e.g. 6 of 10 on a small blurred
+  /// object, let RANSAC pick a flipped pose 100 mm away; hand-held motion is <= 30 mm / 8 deg).
+  double keypoint_max_motion_diameters = 0.0;
+  double keypoint_max_motion_deg = 0.0;  ///< ours: see keypoint_max_motion_diameters (0 = off)
 
   // ---- Cues for hand-held motion in clutter (ours, beyond the paper; off in `paper`) --------
   /// Erosion of the object's rendered mask before corner detection, px: keypoints stay strictly
@@ -70,6 +77,17 @@ struct TrackerParams {
   double region_line_spacing_px = 6.0;  ///< distance between correspondence lines, px
   int region_band_px = 10;              ///< width of the bands colours are learned from, px
   double region_learning_rate = 0.2;    ///< weight of a new frame in the colour histograms, (0, 1]
+
+  /// The tracking session's colour model (object_search.h; off in `paper` and `klt_only`): the
+  /// object's colours are learned at good poses every color_learn_interval_frames; a frame whose
+  /// outline separates them less than color_lost_ratio x their running contrast, or whose object
+  /// is less than 10 % in the image, is a bad frame; while lost, the whole frame is searched for
+  /// them and the best placement with at least color_accept_ratio x the running contrast is
+  /// refined and tracked from.
+  bool color_search = false;
+  int color_learn_interval_frames = 3;  ///< frames between two colour learnings
+  double color_lost_ratio = 0.4;        ///< bad frame below this share of the contrast level
+  double color_accept_ratio = 0.6;      ///< re-acquire from a placement above this share
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline

@@ -12,6 +12,7 @@
 
 #include "klt_contour_tracker/core/camera.h"
 #include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/object_search.h"
 #include "klt_contour_tracker/core/pose.h"
 #include "klt_contour_tracker/core/track_quality.h"
 #include "klt_contour_tracker/core/tracker.h"
@@ -27,6 +28,9 @@ struct SessionResult {
   double quality = 0.0;      ///< the monitor's score in [0, 1]; 0 when the frame has no pose
   bool good = false;         ///< quality >= min_quality (and the frame has a pose)
   bool reacquiring = false;  ///< the frame ran re-acquisition instead of tracking
+  /// Re-acquisition started from the colour search's best placement (color_search).
+  bool searched = false;
+  ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
   bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
   bool restarted = false;    ///< ... and the session restarted from restart_pose()
   /// True unless the status is kNotInitialized or kInvalidInput.
@@ -96,13 +100,17 @@ class TrackingSession {
   void clear_statistics() { statistics_ = {}; }
 
  private:
-  TrackResult reacquire(const Frame& frame);
+  TrackResult reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched);
   void count(const SessionResult& result);
+  /// The colour model's evidence for `result` and its learning on good frames (color_search).
+  void use_colors(const cv::Mat& bgr, SessionResult& result);
 
   std::shared_ptr<const Mesh> mesh_;
   TrackerParams params_;
   TrackQualityMonitor monitor_;
   std::unique_ptr<Tracker> tracker_;
+  std::unique_ptr<ObjectSearch> search_;  ///< the colour model; null unless color_search
+  int frames_since_learning_ = 0;
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
   bool has_last_stamp_ = false;

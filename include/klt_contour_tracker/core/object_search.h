@@ -1,0 +1,92 @@
+#pragma once
+/// \file object_search.h
+/// Finding the object anywhere in a frame by its colours (ours, beyond the paper), for the
+/// tracking session: to tell a lost track (the outline no longer separates the object's colours
+/// from the background's) and to re-acquire it after an occlusion, a fast move or a visit
+/// outside the image, where the local refinement around the last pose cannot reach.
+///
+/// Colours are learned at trusted poses (ColorHistograms, SRT3D's model). The search renders the
+/// object's silhouette at the last good rotation and a few depths and correlates it, as a
+/// template, with the frame's per-pixel foreground posterior (cv::matchTemplate): the score of a
+/// placement is the mean posterior inside the silhouette minus the mean in a ring around it, over
+/// the pixels in the image, so an object entering the image is found once part of it is in.
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "klt_contour_tracker/core/camera.h"
+#include "klt_contour_tracker/core/color_histograms.h"
+#include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/renderer.h"
+
+namespace kct {
+
+/// Settings of the colour search (all ours).
+struct ObjectSearchSettings {
+  int working_width_px = 320;    ///< frames are halved until at most this wide, px
+  int band_px = 4;               ///< width of the learning bands at the working size, px
+  double learning_rate = 0.2;    ///< weight of a new frame in the histograms, (0, 1]
+  /// Depths searched, as factors of the reference pose's depth.
+  std::vector<double> depth_scales = {0.7, 0.85, 1.0, 1.2, 1.45};
+  /// Placements with less of the silhouette inside the image are not scored, (0, 1].
+  double min_visible_fraction = 0.3;
+  /// Width of the ring around the silhouette, as a fraction of its larger side (at least 2 px).
+  double ring_fraction = 0.15;
+
+  /// Throws std::invalid_argument naming the first bad field and its allowed range.
+  void validate() const;
+};
+
+/// A pose the search found and its colour contrast.
+struct SearchCandidate {
+  Pose object_to_camera = Pose::Identity();
+  double contrast = 0.0;          ///< mean posterior inside - in the ring, [-1, 1]
+  double visible_fraction = 0.0;  ///< share of the silhouette inside the image, [0, 1]
+};
+
+/// The object's colour model and the searches that use it.
+class ObjectSearch {
+ public:
+  /// Throws std::invalid_argument for an empty mesh or invalid settings.
+  ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchSettings& settings = {});
+
+  /// Learns the colours from `bgr` (CV_8UC3, undistorted, the camera's size) at a trusted pose.
+  /// Returns false (nothing learned) when the silhouette is too small or mostly outside.
+  bool learn(const cv::Mat& bgr, const Pose& object_to_camera, const PinholeCamera& camera);
+  bool ready() const { return histograms_.ready(); }
+  void clear() { histograms_.clear(); }
+
+  /// Contrast and visible fraction of the silhouette at `object_to_camera` in `bgr` (contrast 0
+  /// when the model is not ready or less than min_visible_fraction of it is in the image).
+  SearchCandidate score(const cv::Mat& bgr, const Pose& object_to_camera,
+                        const PinholeCamera& camera) const;
+
+  /// Searches the whole frame: the rotation of `reference` (object_to_camera) at the depths
+  /// depth_scales x its depth, placed anywhere its silhouette is at least min_visible_fraction
+  /// in the image. One candidate per depth (its best placement), best contrast first; empty when
+  /// the model is not ready.
+  std::vector<SearchCandidate> search(const cv::Mat& bgr, const Pose& reference,
+                                      const PinholeCamera& camera) const;
+
+  const ObjectSearchSettings& settings() const { return settings_; }
+
+ private:
+  /// How often a frame of `width` is halved to reach working_width_px.
+  int halvings(int width) const;
+  /// `bgr` at the working size and the camera scaled to it.
+  cv::Mat working_image(const cv::Mat& bgr, const PinholeCamera& camera,
+                        PinholeCamera& working_camera) const;
+  /// Per-pixel P(foreground | colour) of a working-size image, CV_32F.
+  cv::Mat posterior_map(const cv::Mat& working_bgr) const;
+
+  std::shared_ptr<const Mesh> mesh_;
+  Renderer renderer_;
+  ObjectSearchSettings settings_;
+  ColorHistograms histograms_;
+  double diameter_m_ = 0.0;
+  Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace kct

@@ -1,0 +1,215 @@
+#include "klt_contour_tracker/core/object_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <string>
+
+namespace kct {
+namespace {
+
+void check_range(const char* name, double value, double low, double high) {
+  if (!std::isfinite(value) || value < low || value > high)
+    throw std::invalid_argument(std::string("ObjectSearchSettings.") + name + " must be in [" +
+                                std::to_string(low) + ", " + std::to_string(high) + "], got " +
+                                std::to_string(value));
+}
+
+/// The ring around a silhouette mask: dilated by `ring_px` minus the mask.
+cv::Mat ring_of(const cv::Mat& mask, int ring_px) {
+  cv::Mat dilated;
+  cv::dilate(mask, dilated,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * ring_px + 1, 2 * ring_px + 1}));
+  return dilated & ~mask;
+}
+
+int ring_width_px(const cv::Mat& mask, double fraction) {
+  const cv::Rect box = cv::boundingRect(mask);
+  return std::max(2, static_cast<int>(std::lround(fraction * std::max(box.width, box.height))));
+}
+
+/// The object's centre placed at `pixel` (working camera) at depth `depth_m`, rotation kept.
+Pose placed_at(const Pose& reference, const Eigen::Vector3d& center_object,
+               const PinholeCamera& camera, const Eigen::Vector2d& pixel, double depth_m) {
+  Pose pose = reference;
+  const Eigen::Vector3d center_camera = depth_m * camera.back_project(pixel);
+  pose.translation() = center_camera - reference.linear() * center_object;
+  return pose;
+}
+
+}  // namespace
+
+void ObjectSearchSettings::validate() const {
+  check_range("working_width_px", working_width_px, 32, 100000);
+  check_range("band_px", band_px, 1, 100);
+  check_range("learning_rate", learning_rate, 1e-6, 1.0);
+  if (depth_scales.empty())
+    throw std::invalid_argument("ObjectSearchSettings.depth_scales must not be empty");
+  for (double s : depth_scales) check_range("depth_scales[i]", s, 0.05, 20.0);
+  check_range("min_visible_fraction", min_visible_fraction, 1e-3, 1.0);
+  check_range("ring_fraction", ring_fraction, 0.01, 2.0);
+}
+
+ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchSettings& settings)
+    : mesh_(std::move(mesh)), renderer_(mesh_), settings_(settings) {
+  if (!mesh_ || mesh_->faces.empty()) throw std::invalid_argument("ObjectSearch: empty mesh");
+  settings_.validate();
+  diameter_m_ = mesh_->diameter();
+  center_object_ = mesh_->bounding_box_center();
+}
+
+int ObjectSearch::halvings(int width) const {
+  int steps = 0;
+  while (width > settings_.working_width_px && steps < 8) {
+    width = (width + 1) / 2;
+    ++steps;
+  }
+  return steps;
+}
+
+cv::Mat ObjectSearch::working_image(const cv::Mat& bgr, const PinholeCamera& camera,
+                                    PinholeCamera& working_camera) const {
+  if (bgr.type() != CV_8UC3 || bgr.size() != camera.size())
+    throw std::invalid_argument("ObjectSearch: the image must be CV_8UC3 of the camera's size");
+  const int steps = halvings(bgr.cols);
+  if (steps == 0) {
+    working_camera = PinholeCamera(camera.fx(), camera.fy(), camera.cx(), camera.cy(),
+                                   camera.width(), camera.height());
+    return bgr;
+  }
+  const double s = std::ldexp(1.0, -steps);
+  const cv::Size size(std::max(1, static_cast<int>(std::lround(bgr.cols * s))),
+                      std::max(1, static_cast<int>(std::lround(bgr.rows * s))));
+  const double sx = static_cast<double>(size.width) / bgr.cols;
+  const double sy = static_cast<double>(size.height) / bgr.rows;
+  // Pixel centres: u' + 0.5 = (u + 0.5) * scale.
+  working_camera = PinholeCamera(camera.fx() * sx, camera.fy() * sy, (camera.cx() + 0.5) * sx - 0.5,
+                                 (camera.cy() + 0.5) * sy - 0.5, size.width, size.height);
+  cv::Mat small;
+  cv::resize(bgr, small, size, 0, 0, cv::INTER_AREA);
+  return small;
+}
+
+cv::Mat ObjectSearch::posterior_map(const cv::Mat& working_bgr) const {
+  cv::Mat posterior(working_bgr.size(), CV_32F);
+  for (int r = 0; r < working_bgr.rows; ++r) {
+    const cv::Vec3b* pixels = working_bgr.ptr<cv::Vec3b>(r);
+    float* out = posterior.ptr<float>(r);
+    for (int c = 0; c < working_bgr.cols; ++c) out[c] = histograms_.posterior(pixels[c]);
+  }
+  return posterior;
+}
+
+bool ObjectSearch::learn(const cv::Mat& bgr, const Pose& object_to_camera,
+                         const PinholeCamera& camera) {
+  PinholeCamera working_camera;
+  const cv::Mat small = working_image(bgr, camera, working_camera);
+  RenderOptions options;
+  options.draw_color = false;
+  const cv::Mat mask = renderer_.render(object_to_camera, working_camera, options).mask();
+  return histograms_.learn(small, mask, settings_.band_px, settings_.learning_rate);
+}
+
+SearchCandidate ObjectSearch::score(const cv::Mat& bgr, const Pose& object_to_camera,
+                                    const PinholeCamera& camera) const {
+  SearchCandidate result;
+  result.object_to_camera = object_to_camera;
+  if (!ready() || !(object_to_camera.translation().z() > 0)) return result;
+  PinholeCamera working_camera;
+  const cv::Mat small = working_image(bgr, camera, working_camera);
+  // Rendered on a canvas one image size larger on every side, to know how much of the
+  // silhouette is outside the image.
+  const int pad_x = small.cols, pad_y = small.rows;
+  const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(),
+                                    working_camera.cx() + pad_x, working_camera.cy() + pad_y,
+                                    small.cols + 2 * pad_x, small.rows + 2 * pad_y);
+  RenderOptions options;
+  options.draw_color = false;
+  const cv::Mat canvas = renderer_.render(object_to_camera, canvas_camera, options).mask();
+  const double total = cv::countNonZero(canvas);
+  if (total <= 0) return result;
+  const cv::Rect image_rect(pad_x, pad_y, small.cols, small.rows);
+  const cv::Mat mask = canvas(image_rect);
+  const double inside = cv::countNonZero(mask);
+  result.visible_fraction = inside / total;
+  if (result.visible_fraction < settings_.min_visible_fraction) return result;
+  const cv::Mat ring = ring_of(canvas, ring_width_px(canvas, settings_.ring_fraction))(image_rect);
+  if (cv::countNonZero(ring) == 0) return result;
+  const cv::Mat posterior = posterior_map(small);
+  result.contrast = cv::mean(posterior, mask)[0] - cv::mean(posterior, ring)[0];
+  return result;
+}
+
+std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose& reference,
+                                                  const PinholeCamera& camera) const {
+  std::vector<SearchCandidate> candidates;
+  const double reference_depth = (reference * center_object_).z();
+  if (!ready() || !(reference_depth > 0)) return candidates;
+  PinholeCamera working_camera;
+  const cv::Mat small = working_image(bgr, camera, working_camera);
+  const cv::Mat posterior = posterior_map(small);
+  const cv::Mat valid = cv::Mat::ones(small.size(), CV_32F);
+  RenderOptions options;
+  options.draw_color = false;
+  for (double scale : settings_.depth_scales) {
+    const double depth_m = reference_depth * scale;
+    // The silhouette on a square canvas with the object's centre at the canvas centre.
+    const double radius_px = working_camera.fx() * 0.5 * diameter_m_ / depth_m;
+    const int ring_guess = std::max(2, static_cast<int>(std::ceil(settings_.ring_fraction * 2.0 * radius_px)));
+    const int half = static_cast<int>(std::ceil(radius_px)) + ring_guess + 2;
+    const int side = 2 * half + 1;
+    if (side > 4 * std::max(small.cols, small.rows) || side < 5) continue;
+    const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(), half, half, side,
+                                      side);
+    const Pose centred = placed_at(reference, center_object_, canvas_camera,
+                                   Eigen::Vector2d(half, half), depth_m);
+    const cv::Mat mask = renderer_.render(centred, canvas_camera, options).mask();
+    const double area = cv::countNonZero(mask);
+    if (area < 4) continue;
+    const cv::Mat ring = ring_of(mask, ring_width_px(mask, settings_.ring_fraction));
+    cv::Mat inside_template, ring_template;
+    mask.convertTo(inside_template, CV_32F, 1.0 / 255.0);
+    ring.convertTo(ring_template, CV_32F, 1.0 / 255.0);
+    // Placements reaching outside the image: the frame padded with zeros (posterior and
+    // validity), so sums count only pixels inside it.
+    cv::Mat padded_posterior, padded_valid;
+    cv::copyMakeBorder(posterior, padded_posterior, half, half, half, half, cv::BORDER_CONSTANT, 0);
+    cv::copyMakeBorder(valid, padded_valid, half, half, half, half, cv::BORDER_CONSTANT, 0);
+    cv::Mat posterior_inside, area_inside, posterior_ring, area_ring;
+    cv::matchTemplate(padded_posterior, inside_template, posterior_inside, cv::TM_CCORR);
+    cv::matchTemplate(padded_valid, inside_template, area_inside, cv::TM_CCORR);
+    cv::matchTemplate(padded_posterior, ring_template, posterior_ring, cv::TM_CCORR);
+    cv::matchTemplate(padded_valid, ring_template, area_ring, cv::TM_CCORR);
+    const float min_area = static_cast<float>(settings_.min_visible_fraction * area);
+    double best = -2.0;
+    cv::Point best_at(-1, -1);
+    for (int r = 0; r < posterior_inside.rows; ++r) {
+      const float* pi = posterior_inside.ptr<float>(r);
+      const float* ai = area_inside.ptr<float>(r);
+      const float* pr = posterior_ring.ptr<float>(r);
+      const float* ar = area_ring.ptr<float>(r);
+      for (int c = 0; c < posterior_inside.cols; ++c) {
+        if (ai[c] < min_area || ar[c] < 1.0f) continue;
+        const double contrast = pi[c] / ai[c] - pr[c] / ar[c];
+        if (contrast > best) {
+          best = contrast;
+          best_at = {c, r};
+        }
+      }
+    }
+    if (best_at.x < 0) continue;
+    // Result (c, r) = template's top-left at padded (c, r): its centre is image pixel (c, r).
+    SearchCandidate candidate;
+    candidate.object_to_camera = placed_at(reference, center_object_, working_camera,
+                                           Eigen::Vector2d(best_at.x, best_at.y), depth_m);
+    candidate.contrast = best;
+    candidate.visible_fraction = std::min(1.0, area_inside.at<float>(best_at) / area);
+    candidates.push_back(candidate);
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const SearchCandidate& a, const SearchCandidate& b) { return a.contrast > b.contrast; });
+  return candidates;
+}
+
+}  // namespace kct

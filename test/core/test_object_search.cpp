@@ -1,0 +1,133 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "klt_contour_tracker/core/object_search.h"
+#include "synthetic_scene.h"
+
+namespace kct {
+namespace {
+
+/// A red-ish untextured box over a blue-ish background; colours learned at `learned_at`, the
+/// frame showing the box at `shown_at`.
+class ObjectSearchTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto mesh = std::make_shared<Mesh>(test::make_box(0.08, 0.06, 0.05, /*textured=*/false));
+    mesh->base_color = cv::Vec3b(40, 60, 200);
+    mesh_ = mesh;
+    renderer_ = std::make_unique<Renderer>(mesh_);
+    background_ = cv::Mat(camera_.size(), CV_8UC3, cv::Scalar(200, 120, 40));
+  }
+  cv::Mat frame_at(const Pose& pose) const {
+    return test::render_frame(*renderer_, camera_, pose, background_, 3.0);
+  }
+  /// Distance between the object centres of two poses, metres.
+  double centre_distance(const Pose& a, const Pose& b) const {
+    const Eigen::Vector3d c = mesh_->bounding_box_center();
+    return (a * c - b * c).norm();
+  }
+
+  std::shared_ptr<const Mesh> mesh_;
+  std::unique_ptr<Renderer> renderer_;
+  const PinholeCamera camera_ = test::make_camera();
+  cv::Mat background_;
+};
+
+TEST_F(ObjectSearchTest, NotReadyBeforeLearning) {
+  ObjectSearch search(mesh_);
+  const Pose truth = test::make_pose(0.4);
+  EXPECT_FALSE(search.ready());
+  EXPECT_TRUE(search.search(frame_at(truth), truth, camera_).empty());
+  EXPECT_EQ(search.score(frame_at(truth), truth, camera_).contrast, 0.0);
+}
+
+TEST_F(ObjectSearchTest, ContrastIsHighAtTheObjectAndLowBesideIt) {
+  ObjectSearch search(mesh_);
+  const Pose truth = test::make_pose(0.4);
+  const cv::Mat frame = frame_at(truth);
+  ASSERT_TRUE(search.learn(frame, truth, camera_));
+  const SearchCandidate at_truth = search.score(frame, truth, camera_);
+  EXPECT_GT(at_truth.contrast, 0.8);  // two clean colours: posteriors near 0.99 and 0.01
+  EXPECT_NEAR(at_truth.visible_fraction, 1.0, 1e-9);
+  // Moved sideways by more than the object's size: the silhouette sees only background.
+  const Pose beside = test::move(truth, 0, Eigen::Vector3d::UnitZ(), {0.15, 0.0, 0.0});
+  EXPECT_LT(search.score(frame, beside, camera_).contrast, 0.1);
+}
+
+TEST_F(ObjectSearchTest, VisibleFractionCountsTheSilhouetteOutsideTheImage) {
+  ObjectSearch search(mesh_);
+  const Pose truth = test::make_pose(0.4);
+  ASSERT_TRUE(search.learn(frame_at(truth), truth, camera_));
+  // Centre moved to the image's left border: about half of the silhouette is outside.
+  Pose at_border = truth;
+  const double depth = (truth * mesh_->bounding_box_center()).z();
+  at_border.translation().x() += (-0.5 - camera_.cx()) * depth / camera_.fx() -
+                                 (truth * mesh_->bounding_box_center()).x();
+  const SearchCandidate scored = search.score(frame_at(at_border), at_border, camera_);
+  EXPECT_GT(scored.visible_fraction, 0.3);
+  EXPECT_LT(scored.visible_fraction, 0.7);
+  // Entirely outside.
+  const Pose outside = test::move(truth, 0, Eigen::Vector3d::UnitZ(), {1.0, 0.0, 0.0});
+  EXPECT_EQ(search.score(frame_at(truth), outside, camera_).visible_fraction, 0.0);
+}
+
+TEST_F(ObjectSearchTest, FindsTheObjectFarFromTheReferencePose) {
+  ObjectSearch search(mesh_);
+  const Pose learned_at = test::make_pose(0.4);
+  ASSERT_TRUE(search.learn(frame_at(learned_at), learned_at, camera_));
+  // The object is now 12 cm to the side, 6 cm lower and 8 cm farther, rotated by 10 deg: far
+  // outside any local refinement's reach from the reference.
+  const Pose shown_at =
+      test::move(learned_at, 10, Eigen::Vector3d(0.3, 1.0, 0.2), {0.12, 0.06, 0.08});
+  const std::vector<SearchCandidate> found = search.search(frame_at(shown_at), learned_at, camera_);
+  ASSERT_FALSE(found.empty());
+  EXPECT_GT(found.front().contrast, 0.6);
+  for (std::size_t i = 1; i < found.size(); ++i)
+    EXPECT_GE(found[i - 1].contrast, found[i].contrast);  // best first
+  // The placement puts the centre within 15 % of the object's distance error and 1.5 cm
+  // sideways (the depth is searched in steps of about 15-20 %).
+  const Eigen::Vector3d c = mesh_->bounding_box_center();
+  const Eigen::Vector3d found_centre = found.front().object_to_camera * c;
+  const Eigen::Vector3d true_centre = shown_at * c;
+  EXPECT_LT(std::abs(found_centre.z() - true_centre.z()), 0.15 * true_centre.z());
+  const Eigen::Vector2d found_px = camera_.project(found_centre);
+  const Eigen::Vector2d true_px = camera_.project(true_centre);
+  EXPECT_LT((found_px - true_px).norm(), 8.0);
+  // The rotation is the reference's (the refinement's job).
+  EXPECT_TRUE(found.front().object_to_camera.linear().isApprox(learned_at.linear(), 1e-12));
+}
+
+TEST_F(ObjectSearchTest, FindsAnObjectEnteringTheImage) {
+  ObjectSearch search(mesh_);
+  const Pose learned_at = test::make_pose(0.4);
+  ASSERT_TRUE(search.learn(frame_at(learned_at), learned_at, camera_));
+  // Centre 20 px inside the left border: a bit over half of the box is in the image.
+  Pose entering = learned_at;
+  const Eigen::Vector3d c = learned_at * mesh_->bounding_box_center();
+  entering.translation().x() += (20.0 - camera_.cx()) * c.z() / camera_.fx() - c.x();
+  const std::vector<SearchCandidate> found = search.search(frame_at(entering), learned_at, camera_);
+  ASSERT_FALSE(found.empty());
+  const Eigen::Vector2d found_px =
+      camera_.project(found.front().object_to_camera * mesh_->bounding_box_center());
+  const Eigen::Vector2d true_px = camera_.project(entering * mesh_->bounding_box_center());
+  EXPECT_LT((found_px - true_px).norm(), 8.0);
+  EXPECT_LT(found.front().visible_fraction, 0.9);
+}
+
+TEST(ObjectSearchSettings, RejectsBadValues) {
+  auto mesh = std::make_shared<Mesh>(test::make_box(0.08, 0.06, 0.05));
+  ObjectSearchSettings settings;
+  settings.depth_scales.clear();
+  EXPECT_THROW(ObjectSearch(mesh, settings), std::invalid_argument);
+  settings = {};
+  settings.min_visible_fraction = 0.0;
+  EXPECT_THROW(ObjectSearch(mesh, settings), std::invalid_argument);
+  settings = {};
+  settings.learning_rate = 2.0;
+  EXPECT_THROW(ObjectSearch(mesh, settings), std::invalid_argument);
+  EXPECT_THROW(ObjectSearch(nullptr), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace kct
