@@ -5,7 +5,6 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 namespace kct {
 namespace {
@@ -33,24 +32,6 @@ inline Eigen::Vector2d bilinear_derivative(const cv::Mat& image, int x0, int y0,
           (1.0 - fx) * (r1[0] - r0[0]) + fx * (r1[1] - r0[1])};
 }
 
-/// Runs fn(i) for i < n on up to `threads` threads (the caller's included). Each i must write
-/// only its own outputs, so the result does not depend on the thread count.
-template <typename Fn>
-void run_parallel(int n, int threads, Fn&& fn) {
-  threads = std::max(1, std::min(threads, n));
-  if (threads == 1) {
-    for (int i = 0; i < n; ++i) fn(i);
-    return;
-  }
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t)
-    pool.emplace_back([&, t]() {
-      for (int i = t; i < n; i += threads) fn(i);
-    });
-  for (int i = 0; i < n; i += threads) fn(i);
-  for (auto& thread : pool) thread.join();
-}
-
 }  // namespace
 
 ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, double spacing_px,
@@ -58,8 +39,7 @@ ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, doub
     : extractor_(std::move(extractor)),
       spacing_px_(spacing_px),
       blur_sigma_px_(blur_sigma_px),
-      edge_width_px_(std::sqrt(blur_sigma_px * blur_sigma_px + 1.0)),
-      num_threads_(num_threads) {
+      edge_width_px_(std::sqrt(blur_sigma_px * blur_sigma_px + 1.0)) {
   if (!extractor_) throw std::invalid_argument("ContourCost: extractor is null");
   if (!(spacing_px > 0.0) || !std::isfinite(spacing_px))
     throw std::invalid_argument("ContourCost: spacing_px must be > 0, got " +
@@ -70,6 +50,8 @@ ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, doub
   if (num_threads < 1)
     throw std::invalid_argument("ContourCost: num_threads must be >= 1, got " +
                                 std::to_string(num_threads));
+  // At most one thread per pyramid level is used; the workers live as long as the cost.
+  workers_ = std::make_unique<WorkerThreads>(num_threads);
 }
 
 void ContourCost::begin_frame(const PoseCostFrame& frame) {
@@ -98,7 +80,7 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
   }
 
   levels_.assign(frame.levels.size(), LevelImages());
-  run_parallel(static_cast<int>(frame.levels.size()), num_threads_, [&](int l) {
+  workers_->parallel_for(static_cast<int>(frame.levels.size()), [&](int l) {
     const PyramidLevel& level = frame.levels[l];
     LevelImages& out = levels_[l];
     const cv::Rect bounds(0, 0, level.gray.cols, level.gray.rows);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -13,6 +12,7 @@
 #include "klt_contour_tracker/core/plausibility.h"
 #include "klt_contour_tracker/core/pose_refiner.h"
 #include "klt_contour_tracker/core/region_cost.h"
+#include "klt_contour_tracker/core/worker_threads.h"
 
 namespace kct {
 
@@ -40,6 +40,7 @@ Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
   keypoints_.set_object_extent(diameter_m_, center_object_);
   set_camera(camera);
   if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
+  workers_ = std::make_unique<WorkerThreads>(params_.num_threads);
   configure_motion_model();
   configure_cues();
 }
@@ -113,6 +114,8 @@ void Tracker::set_params(const TrackerParams& params) {
   keypoints_.set_params(params_);
   if (params_.refine && !refiner_) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   if (refiner_) refiner_->set_params(params_);
+  if (workers_->threads() != params_.num_threads)
+    workers_ = std::make_unique<WorkerThreads>(params_.num_threads);
   if (motion_changed) configure_motion_model();
   configure_cues();  // the colours are learned again
 }
@@ -295,17 +298,16 @@ TrackResult Tracker::track(const Frame& frame) {
   // expected pose: with a second thread it runs while KLT does. The same call is made either
   // way, so the result does not depend on num_threads.
   const bool prepare = params_.refine && refiner_ && params_.optimizer == "coarse_to_fine";
-  std::future<void> prepared;
-  if (prepare && params_.num_threads >= 2)
-    prepared = std::async(std::launch::async,
-                          [&]() { refiner_->prepare_frame(gray, camera_, predicted, bgr); });
+  WorkerThreads::Pending prepared;
+  if (prepare && workers_->threads() >= 2)
+    prepared = workers_->start([&]() { refiner_->prepare_frame(gray, camera_, predicted, bgr); });
   else if (prepare)
     refiner_->prepare_frame(gray, camera_, predicted, bgr);
 
   // Sec. 3.1: preliminary pose from KLT + PnP, or extrapolated when KLT fails.
   result.keypoints = keypoints_.track(gray, motion_ ? predicted : pose_i1_, camera_,
                                       motion_ ? &prediction : nullptr);
-  if (prepared.valid()) prepared.get();  // rethrows the preparation's exception, if any
+  prepared.wait();  // rethrows the preparation's exception, if any
   result.times.klt_ms = result.keypoints.klt_ms;
   result.times.pnp_ms = result.keypoints.pnp_ms;
   if (result.keypoints.success) {

@@ -9,6 +9,7 @@
 
 #include "klt_contour_tracker/core/contour_extractor.h"
 #include "klt_contour_tracker/core/pose_cost.h"
+#include "klt_contour_tracker/core/worker_threads.h"
 
 namespace kct {
 
@@ -80,7 +81,7 @@ class ContourCost : public PoseCost {
   double spacing_px_;
   double blur_sigma_px_;
   double edge_width_px_;
-  int num_threads_;
+  std::unique_ptr<WorkerThreads> workers_;  ///< num_threads threads, the caller's included
   const PoseCostFrame* frame_ = nullptr;
   std::vector<LevelImages> levels_;
   int level_ = 0;

@@ -23,6 +23,7 @@ class ContourExtractor;
 class MotionModel;
 class RegionCost;
 class MotionPriorCost;
+class WorkerThreads;
 
 /// One camera image. 8-bit grey (CV_8UC1) or BGR (CV_8UC3); undistorted unless the camera
 /// given to the tracker has distortion coefficients.
@@ -131,6 +132,8 @@ class Tracker {
   std::unique_ptr<MotionModel> motion_;  ///< null unless params_.motion_model
   std::shared_ptr<RegionCost> region_cost_;       ///< null unless region_weight > 0
   std::shared_ptr<MotionPriorCost> motion_prior_;  ///< null unless motion_prior_weight > 0
+  /// params_.num_threads threads (the caller's included), persistent: see worker_threads.h.
+  std::unique_ptr<WorkerThreads> workers_;
   cv::Mat undistort_map_x_, undistort_map_y_;
   double diameter_m_ = 0.0;                         ///< mesh diameter, metres
   Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();  ///< bounding-box centre, object frame
