@@ -203,7 +203,8 @@ std::string Tracker::check_frame(const Frame& frame) const {
   return "";
 }
 
-TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double search_scale) {
+TrackResult Tracker::refine_hypothesis(const Frame& frame, const Pose& around,
+                                       double search_scale) {
   const auto start = std::chrono::steady_clock::now();
   if (!(search_scale >= 1.0) || !std::isfinite(search_scale))
     throw std::invalid_argument("Tracker::reacquire: search_scale must be >= 1");
@@ -214,10 +215,10 @@ TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double se
   if (!result.message.empty()) {
     result.status = TrackStatus::kInvalidInput;
   } else {
-    const cv::Mat gray = to_gray(frame.image);
     result.status = TrackStatus::kReacquired;
     result.object_to_camera = result.preliminary_object_to_camera = around;
     if (params_.refine && refiner_) {
+      const cv::Mat gray = to_gray(frame.image);
       TrackerParams widened = params_;
       widened.extrapolated_rotation_bound_deg =
           std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);
@@ -234,14 +235,27 @@ TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double se
       refiner_->set_params(params_);
       apply_refinement(refined, result);
     }
-    pose_i1_ = pose_i2_ = result.object_to_camera;
-    if (motion_) motion_->reset(pose_i1_);
-    keypoints_.clear();
-    detect_keypoints(gray, result);
-    state_ = State::kTracking;
   }
   result.frame_time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+void Tracker::adopt(const Frame& frame, TrackResult& result) {
+  if (result.status != TrackStatus::kReacquired) return;
+  const auto start = std::chrono::steady_clock::now();
+  pose_i1_ = pose_i2_ = result.object_to_camera;
+  if (motion_) motion_->reset(pose_i1_);
+  keypoints_.clear();
+  detect_keypoints(to_gray(frame.image), result);
+  state_ = State::kTracking;
+  result.frame_time_ms +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double search_scale) {
+  TrackResult result = refine_hypothesis(frame, around, search_scale);
+  adopt(frame, result);
   return result;
 }
 

@@ -1,5 +1,6 @@
 #include "klt_contour_tracker/core/tracking_session.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace kct {
@@ -63,16 +64,53 @@ void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
 
 TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched) {
   searched = false;
+  const Pose& last_good = monitor_.last_good_pose();
   if (search_ && search_->ready() && !bgr.empty() && monitor_.color_level() > 0.0) {
-    const std::vector<SearchCandidate> found =
-        search_->search(bgr, monitor_.last_good_pose(), tracker_->camera());
-    if (!found.empty() &&
-        found.front().contrast >= params_.color_accept_ratio * monitor_.color_level()) {
+    // Hypotheses: the best colour placements, each at the last good rotation and turned by
+    // +-color_search_rotation_deg about the camera axes (the object may have turned while it
+    // was hidden), plus the last good pose; each refined, the best colour contrast wins.
+    const PinholeCamera& camera = tracker_->camera();
+    std::vector<SearchCandidate> found = search_->search(bgr, last_good, camera);
+    if (static_cast<int>(found.size()) > params_.color_search_placements)
+      found.resize(static_cast<std::size_t>(params_.color_search_placements));
+    std::vector<Pose> hypotheses{last_good};
+    const Eigen::Vector3d center_object = mesh_->bounding_box_center();
+    const double angle = params_.color_search_rotation_deg * M_PI / 180.0;
+    for (const SearchCandidate& candidate : found) {
+      const Pose& placed = candidate.object_to_camera;
+      hypotheses.push_back(placed);
+      if (angle <= 0.0) continue;
+      const Eigen::Vector3d center_camera = placed * center_object;
+      for (int axis = 0; axis < 3; ++axis)
+        for (const double sign : {-1.0, 1.0}) {
+          Pose turned = placed;
+          turned.linear() =
+              Eigen::AngleAxisd(sign * angle, Eigen::Vector3d::Unit(axis)) * placed.linear();
+          turned.translation() = center_camera - turned.linear() * center_object;
+          hypotheses.push_back(turned);
+        }
+    }
+    TrackResult best;
+    double best_contrast = -2.0;
+    double time_ms = 0.0;
+    for (const Pose& hypothesis : hypotheses) {
+      TrackResult refined = tracker_->refine_hypothesis(frame, hypothesis, 1.0);
+      time_ms += refined.frame_time_ms;
+      if (refined.status != TrackStatus::kReacquired) return refined;  // invalid frame
+      const double contrast = search_->score(bgr, refined.object_to_camera, camera).contrast;
+      if (contrast > best_contrast) {
+        best_contrast = contrast;
+        best = refined;
+      }
+    }
+    if (best_contrast >= params_.color_accept_ratio * monitor_.color_level()) {
       searched = true;
-      return tracker_->reacquire(frame, found.front().object_to_camera, 1.0);
+      best.frame_time_ms = time_ms;
+      tracker_->adopt(frame, best);
+      return best;
     }
   }
-  return tracker_->reacquire(frame, monitor_.last_good_pose(), monitor_.params().reacquire_search_scale);
+  return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 
 void TrackingSession::use_colors(const cv::Mat& bgr, SessionResult& result) {

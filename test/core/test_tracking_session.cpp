@@ -146,3 +146,53 @@ TEST(TrackingSession, ResetWaitsForAPoseAndInvalidFramesChangeNothing) {
 
 }  // namespace
 }  // namespace kct
+
+namespace kct {
+namespace {
+
+/// The colour search of the realtime preset (color_search): a red box over a textured blue-grey
+/// background is hidden, then shown again 12 cm to the side and 8 deg turned, far outside the
+/// local refinement's reach; the session must find it again within 10 frames.
+TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
+  auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  mesh->base_color = cv::Vec3b(30, 40, 210);
+  const Renderer renderer(mesh);
+  const PinholeCamera camera = test::make_camera();
+  cv::Mat background = test::make_background(camera.size(), 5);
+  background = background * 0.5 + cv::Scalar(90, 70, 40);  // blue-grey, unlike the box
+  const Pose start = test::make_pose(0.45);
+  const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 2;
+  params.visibility_resolution_px = 128;
+  params.visibility_cache_dir = "";
+  for (const bool with_search : {false, true}) {
+    params.color_search = with_search;
+    TrackingSession session(mesh, params);
+    session.set_camera(camera);
+    session.initialize(start);
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033) {
+      const SessionResult r =
+          session.track({test::render_frame(renderer, camera, start, background, 1.5, i), stamp});
+      ASSERT_EQ(r.state, TrackState::kTracking) << i;
+    }
+    for (int i = 0; i < 12; ++i, stamp += 0.033)
+      session.track({background.clone(), stamp});
+    ASSERT_EQ(session.state(), TrackState::kLost) << "the hidden object must be declared lost";
+    bool back = false;
+    for (int i = 0; i < 10 && !back; ++i, stamp += 0.033) {
+      const SessionResult r =
+          session.track({test::render_frame(renderer, camera, away, background, 1.5, 50 + i), stamp});
+      back = r.state == TrackState::kTracking &&
+             translation_error(r.frame.object_to_camera, away) < 0.01 &&
+             rotation_error_deg(r.frame.object_to_camera, away) < 3.0;
+    }
+    // Without the search the refinement around the last good pose cannot reach it.
+    EXPECT_EQ(back, with_search) << (with_search ? "not re-acquired within 10 frames"
+                                                 : "found without the colour search?");
+  }
+}
+
+}  // namespace
+}  // namespace kct

@@ -85,6 +85,12 @@ class Tracker {
   /// (klt_only) the pose is `around`. Status kReacquired, or kInvalidInput as in track().
   /// Throws std::invalid_argument for an invalid `around` or search_scale < 1.
   TrackResult reacquire(const Frame& frame, const Pose& around, double search_scale);
+  /// The refinement step of reacquire() alone: the track is not changed (to compare several
+  /// re-acquisition hypotheses on one frame). Same exceptions as reacquire().
+  TrackResult refine_hypothesis(const Frame& frame, const Pose& around, double search_scale);
+  /// The rest of reacquire(): tracking continues from `result` (a refine_hypothesis() result on
+  /// `frame`; anything else is ignored), keypoints re-anchored there; adds the time to it.
+  void adopt(const Frame& frame, TrackResult& result);
 
   /// Changes the intrinsics (e.g. a new camera_info); keeps the track. Throws
   /// std::invalid_argument for an implausible camera (implausible_camera()).

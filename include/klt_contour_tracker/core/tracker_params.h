@@ -88,6 +88,11 @@ struct TrackerParams {
   int color_learn_interval_frames = 3;  ///< frames between two colour learnings
   double color_lost_ratio = 0.4;        ///< bad frame below this share of the contrast level
   double color_accept_ratio = 0.6;      ///< re-acquire from a placement above this share
+  /// Re-acquisition refines the best color_search_placements colour placements, each also
+  /// turned by +-color_search_rotation_deg about the camera axes (0: not turned), and the last
+  /// good pose, and continues from the refined pose with the best colour contrast.
+  int color_search_placements = 2;
+  double color_search_rotation_deg = 20.0;
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline
