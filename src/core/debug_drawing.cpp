@@ -27,7 +27,7 @@ void draw_axes(cv::Mat& canvas, const Pose& pose, const PinholeCamera& camera, d
 }  // namespace
 
 cv::Mat draw_tracking_overlay(const cv::Mat& image, const TrackResult& result,
-                              const PinholeCamera& camera, const Mesh& mesh,
+                              const PinholeCamera& camera, const Mesh& mesh, double diameter_m,
                               const ContourExtractor* extractor, const std::string& label) {
   cv::Mat canvas;
   if (image.channels() == 1)
@@ -54,7 +54,7 @@ cv::Mat draw_tracking_overlay(const cv::Mat& image, const TrackResult& result,
     }
     for (const Eigen::Vector2d& p : result.keypoints.inlier_points.points_image)
       cv::drawMarker(canvas, to_cv(p), kKeypointColour, cv::MARKER_CROSS, 5, 1);
-    draw_axes(canvas, pose, camera, 0.3 * mesh.diameter());
+    draw_axes(canvas, pose, camera, 0.3 * diameter_m);
   }
   char text[256];
   std::snprintf(text, sizeof(text), "%s%s%s | KLT %d/%d | E %.1f -> %.1f | hops %d | %.0f ms",

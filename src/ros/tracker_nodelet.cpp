@@ -500,7 +500,8 @@ void TrackerNodelet::publish_pose(const std_msgs::Header& header, const kct::Tra
     const double scale = result.status == kct::TrackStatus::kReacquired
                              ? std::pow(session_->quality_params().reacquire_search_scale, 2)
                              : 1.0;
-    covariance = kct::search_box_pose_covariance(mesh_->diameter(), session_->params(), scale);
+    covariance = kct::search_box_pose_covariance(session_->tracker().diameter_m(),
+                                                 session_->params(), scale);
   }
   auto with_covariance = boost::make_shared<geometry_msgs::PoseWithCovarianceStamped>();
   with_covariance->header = header;
@@ -569,6 +570,7 @@ void TrackerNodelet::publish_debug_image(const sensor_msgs::ImageConstPtr& image
                             (published ? "" : " (not published)");
   cv_bridge::CvImage out(image->header, "bgr8",
                          kct::draw_tracking_overlay(input, result, camera, *mesh_,
+                                                    session_->tracker().diameter_m(),
                                                     session_->tracker().contour_extractor(), label));
   debug_image_pub_.publish(out.toImageMsg());
 }

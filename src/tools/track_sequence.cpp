@@ -173,7 +173,8 @@ int main(int argc, char** argv) {
         const std::string label = std::string(kct::to_string(result.state)) +
                                   cv::format(" q %.2f", result.quality);
         if (!cv::imwrite(path, kct::draw_tracking_overlay(image, result.frame, session.tracker().camera(),
-                                                         *mesh, session.tracker().contour_extractor(), label)))
+                                                         *mesh, session.tracker().diameter_m(),
+                                                         session.tracker().contour_extractor(), label)))
           throw std::runtime_error(path + ": cannot write");
       }
       if (!options.quiet) {
