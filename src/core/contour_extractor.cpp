@@ -115,26 +115,29 @@ void ContourExtractor::compute_face_states(const Pose& object_to_camera) const {
   const Eigen::Matrix3d r = object_to_camera.linear();
   const Eigen::Vector3d camera_object = -(r.transpose() * object_to_camera.translation());
 
-  const std::uint64_t* invisible = nullptr;
-  if (visibility_) {
-    const int icosphere_face =
-        visibility_->icosphere_face(camera_object - visibility_->center_object());
-    if (icosphere_face != cached_icosphere_face_) {
-      visibility_->invisible_bits(icosphere_face, cached_invisible_);
-      cached_icosphere_face_ = icosphere_face;
-    }
-    invisible = cached_invisible_.data();
-  }
-
+  const std::uint64_t* invisible = invisible_bits(camera_object);
   const int face_count = static_cast<int>(face_planes_.size());
-  for (int f = 0; f < face_count; ++f) {
-    const FacePlane& plane = face_planes_[f];
-    // (v - c) . n < 0 with v on the face: the face's front side looks at the camera.
-    const bool front = plane.normal.dot(camera_object) > plane.offset;
-    const bool hidden = invisible && ((invisible[f >> 6] >> (f & 63)) & 1u);
-    face_state_[f] =
-        static_cast<std::uint8_t>((front ? kFront : 0) | (front && !hidden ? kFrontVisible : 0));
+  for (int f = 0; f < face_count; ++f) face_state_[f] = face_state(f, camera_object, invisible);
+}
+
+const std::uint64_t* ContourExtractor::invisible_bits(const Eigen::Vector3d& camera_object) const {
+  if (!visibility_) return nullptr;
+  const int icosphere_face =
+      visibility_->icosphere_face(camera_object - visibility_->center_object());
+  if (icosphere_face != cached_icosphere_face_) {
+    visibility_->invisible_bits(icosphere_face, cached_invisible_);
+    cached_icosphere_face_ = icosphere_face;
   }
+  return cached_invisible_.data();
+}
+
+std::uint8_t ContourExtractor::face_state(int f, const Eigen::Vector3d& camera_object,
+                                          const std::uint64_t* invisible) const {
+  const FacePlane& plane = face_planes_[f];
+  // (v - c) . n < 0 with v on the face: the face's front side looks at the camera.
+  const bool front = plane.normal.dot(camera_object) > plane.offset;
+  const bool hidden = invisible && ((invisible[f >> 6] >> (f & 63)) & 1u);
+  return static_cast<std::uint8_t>((front ? kFront : 0) | (front && !hidden ? kFrontVisible : 0));
 }
 
 template <typename State>
@@ -223,23 +226,9 @@ void ContourExtractor::extract(const Pose& object_to_camera, const PinholeCamera
   if (!(candidate_radius_ >= 0.0) ||
       !((camera_object - candidate_camera_).norm() <= candidate_radius_))
     rebuild_candidates(camera_object);
-  const std::uint64_t* invisible = nullptr;
-  if (visibility_) {
-    const int icosphere_face =
-        visibility_->icosphere_face(camera_object - visibility_->center_object());
-    if (icosphere_face != cached_icosphere_face_) {
-      visibility_->invisible_bits(icosphere_face, cached_invisible_);
-      cached_icosphere_face_ = icosphere_face;
-    }
-    invisible = cached_invisible_.data();
-  }
-  // Same test as compute_face_states(), for the candidates' faces only.
-  const auto state = [&](int f) {
-    const FacePlane& plane = face_planes_[f];
-    const bool front = plane.normal.dot(camera_object) > plane.offset;
-    const bool hidden = invisible && ((invisible[f >> 6] >> (f & 63)) & 1u);
-    return static_cast<std::uint8_t>((front ? kFront : 0) | (front && !hidden ? kFrontVisible : 0));
-  };
+  const std::uint64_t* invisible = invisible_bits(camera_object);
+  // As compute_face_states(), for the candidates' faces only.
+  const auto state = [&](int f) { return face_state(f, camera_object, invisible); };
   const std::vector<Eigen::Vector3d>& vertices = mesh_->vertices;
   for (const int i : candidates_) {  // ascending edge order, as a full classify()
     const EdgeInfo& e = edge_info_[i];

@@ -29,6 +29,7 @@
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/renderer.h"
 #include "klt_contour_tracker/core/sequence_io.h"
+#include "tool_args.h"
 
 namespace {
 
@@ -73,22 +74,17 @@ int main(int argc, char** argv) {
   std::string sequence_dir, model, poses_path, per_frame, summary_json;
   double model_scale = 1.0, tolerance_px = 2.0;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg == "-h" || arg == "--help") {
-        std::cout << kUsage;
-        return 0;
-      }
-      if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-      const std::string value = argv[++i];
-      if (arg == "--sequence") sequence_dir = value;
-      else if (arg == "--model") model = value;
-      else if (arg == "--poses") poses_path = value;
-      else if (arg == "--model-scale") model_scale = std::stod(value);
-      else if (arg == "--tolerance-px") tolerance_px = std::stod(value);
-      else if (arg == "--per-frame") per_frame = value;
-      else if (arg == "--summary-json") summary_json = value;
-      else throw std::invalid_argument("unknown option " + arg);
+    using kct_tools::store;
+    if (!kct_tools::parse_tool_options(argc, argv,
+                                       {{"--sequence", store(sequence_dir)},
+                                        {"--model", store(model)},
+                                        {"--poses", store(poses_path)},
+                                        {"--model-scale", store(model_scale)},
+                                        {"--tolerance-px", store(tolerance_px)},
+                                        {"--per-frame", store(per_frame)},
+                                        {"--summary-json", store(summary_json)}})) {
+      std::cout << kUsage;
+      return 0;
     }
     if (sequence_dir.empty() || model.empty() || poses_path.empty())
       throw std::invalid_argument("--sequence, --model and --poses are required");

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "klt_contour_tracker/core/sequence_io.h"
+#include "tool_args.h"
 
 namespace fs = std::filesystem;
 
@@ -95,23 +96,18 @@ int main(int argc, char** argv) {
   std::string images, prefix, xml, initial_pose, camera_poses, output;
   int first = 0, max_frames = -1;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg == "-h" || arg == "--help") {
-        std::cout << kUsage;
-        return 0;
-      }
-      if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-      const std::string value = argv[++i];
-      if (arg == "--images") images = value;
-      else if (arg == "--prefix") prefix = value;
-      else if (arg == "--camera-xml") xml = value;
-      else if (arg == "--initial-pose") initial_pose = value;
-      else if (arg == "--camera-poses") camera_poses = value;
-      else if (arg == "--output-dir") output = value;
-      else if (arg == "--first") first = std::stoi(value);
-      else if (arg == "--max-frames") max_frames = std::stoi(value);
-      else throw std::invalid_argument("unknown option " + arg);
+    using kct_tools::store;
+    if (!kct_tools::parse_tool_options(argc, argv,
+                                       {{"--images", store(images)},
+                                        {"--prefix", store(prefix)},
+                                        {"--camera-xml", store(xml)},
+                                        {"--initial-pose", store(initial_pose)},
+                                        {"--camera-poses", store(camera_poses)},
+                                        {"--output-dir", store(output)},
+                                        {"--first", store(first)},
+                                        {"--max-frames", store(max_frames)}})) {
+      std::cout << kUsage;
+      return 0;
     }
     if (images.empty() || xml.empty() || output.empty() || initial_pose.empty() == camera_poses.empty())
       throw std::invalid_argument("need --images, --camera-xml, --output-dir and one of "

@@ -22,6 +22,7 @@
 #include "klt_contour_tracker/core/sequence_io.h"
 #include "klt_contour_tracker/core/sequence_run.h"
 #include "klt_contour_tracker/core/tracker.h"
+#include "tool_args.h"
 
 namespace {
 
@@ -62,36 +63,32 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage((arg + " needs a value").c_str());
-      return argv[++i];
-    };
-    try {
-      if (arg == "--sequence") o.sequence = value();
-      else if (arg == "--model") o.model = value();
-      else if (arg == "--model-scale") o.model_scale = std::stod(value());
-      else if (arg == "--preset") o.preset = value();
-      else if (arg == "--output") o.output = value();
-      else if (arg == "--summary-json") o.summary_json = value();
-      else if (arg == "--errors") o.errors = value();
-      else if (arg == "--max-frames") o.max_frames = std::stoi(value());
-      else if (arg == "--max-image-pixels") o.max_image_pixels = std::stoll(value());
-      else if (arg == "--quiet") o.quiet = true;
-      else if (arg == "--debug-dir") o.debug_dir = value();
-      else if (arg == "--debug-every") o.debug_every = std::max(1, std::stoi(value()));
-      else if (arg == "--param") {
-        const std::string kv = value();
-        const auto eq = kv.find('=');
-        if (eq == std::string::npos) usage("--param takes NAME=VALUE");
-        o.overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-      } else if (arg == "-h" || arg == "--help") usage(nullptr);
-      else usage(("unknown argument " + arg).c_str());
-    } catch (const std::logic_error&) {
-      usage(("bad number for " + arg).c_str());
-    }
+  using kct_tools::store;
+  try {
+    const bool run = kct_tools::parse_tool_options(
+        argc, argv,
+        {{"--sequence", store(o.sequence)},
+         {"--model", store(o.model)},
+         {"--model-scale", store(o.model_scale)},
+         {"--preset", store(o.preset)},
+         {"--output", store(o.output)},
+         {"--summary-json", store(o.summary_json)},
+         {"--errors", store(o.errors)},
+         {"--max-frames", store(o.max_frames)},
+         {"--max-image-pixels", store(o.max_image_pixels)},
+         kct_tools::flag("--quiet", o.quiet),
+         {"--debug-dir", store(o.debug_dir)},
+         {"--debug-every", store(o.debug_every)},
+         {"--param", [&o](const std::string& kv) {
+            const auto eq = kv.find('=');
+            if (eq == std::string::npos) throw std::invalid_argument("takes NAME=VALUE");
+            o.overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+          }}});
+    if (!run) usage(nullptr);
+  } catch (const std::invalid_argument& e) {
+    usage(e.what());
   }
+  o.debug_every = std::max(1, o.debug_every);
   if (o.sequence.empty() || o.model.empty()) usage("--sequence and --model are required");
   return o;
 }

@@ -2,6 +2,7 @@
 // Synthetic scenes for the core tests: a textured box, a noisy background, and rendered
 // frames at known poses. Everything is made here, so the tests need no file outside the repo.
 
+#include <memory>
 #include <opencv2/imgproc.hpp>
 
 #include "klt_contour_tracker/core/camera.h"
@@ -67,6 +68,13 @@ inline void append_box(Mesh& mesh, const Eigen::Vector3d& lo, const Eigen::Vecto
       if ((b - a).cross(c - a).dot(a - center) < 0.0) std::swap(f[1], f[2]);
       mesh.faces.push_back(f);
     }
+}
+
+/// Axis-aligned cube of side `side_m` centred at the origin (append_box()), untextured.
+inline std::shared_ptr<Mesh> make_cube(double side_m) {
+  auto mesh = std::make_shared<Mesh>();
+  append_box(*mesh, Eigen::Vector3d::Constant(-0.5 * side_m), Eigen::Vector3d::Constant(0.5 * side_m));
+  return mesh;
 }
 
 /// Smooth random colour background (seeded): uniform noise on a grid of `cell_px` cells with

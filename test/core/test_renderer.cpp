@@ -7,23 +7,11 @@
 #include <vector>
 
 #include "klt_contour_tracker/core/renderer.h"
+#include "synthetic_scene.h"
 
 namespace {
 
-/// Axis-aligned cube of side `side` centred at the origin, faces CCW from outside.
-std::shared_ptr<kct::Mesh> make_cube(double side) {
-  auto mesh = std::make_shared<kct::Mesh>();
-  const double h = 0.5 * side;
-  for (int i = 0; i < 8; ++i)
-    mesh->vertices.emplace_back((i & 1) ? h : -h, (i & 2) ? h : -h, (i & 4) ? h : -h);
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    mesh->faces.emplace_back(q[0], q[1], q[2]);
-    mesh->faces.emplace_back(q[0], q[2], q[3]);
-  }
-  return mesh;
-}
+using kct::test::make_cube;
 
 const kct::PinholeCamera kCamera(500.0, 480.0, 319.5, 239.5, 640, 480);
 

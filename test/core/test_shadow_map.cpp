@@ -5,21 +5,11 @@
 
 #include "klt_contour_tracker/core/renderer.h"
 #include "klt_contour_tracker/core/shadow_map.h"
+#include "synthetic_scene.h"
 
 namespace {
 
-std::shared_ptr<kct::Mesh> make_box(double half) {
-  auto mesh = std::make_shared<kct::Mesh>();
-  for (int i = 0; i < 8; ++i)
-    mesh->vertices.emplace_back((i & 1) ? half : -half, (i & 2) ? half : -half, (i & 4) ? half : -half);
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    mesh->faces.emplace_back(q[0], q[1], q[2]);
-    mesh->faces.emplace_back(q[0], q[2], q[3]);
-  }
-  return mesh;
-}
+using kct::test::make_cube;
 
 kct::Pose at(const Eigen::Vector3d& t) {
   kct::Pose pose = kct::Pose::Identity();
@@ -34,8 +24,8 @@ const kct::PinholeCamera kCamera(500.0, 500.0, 319.5, 239.5, 640, 480);
 // A 10 cm box at 0.5 m, a wall at 0.8 m, light towards +x and the camera (direction
 // (0.5, 0, -1)): the shadow on the wall is the box shifted by 0.3 m * 0.5 = 0.15 m towards -x.
 TEST(ShadowMap, ShadowFallsWhereTheLightRayHitsTheCaster) {
-  const auto box = make_box(0.05);
-  const auto wall = make_box(0.6);  // only its front face (z = 0.8 - 0.6 ... ) matters
+  const auto box = make_cube(0.1);
+  const auto wall = make_cube(1.2);  // only its front face (z = 0.8 - 0.6 ... ) matters
   const Eigen::Vector3d light(0.5, 0.0, -1.0);
   const kct::ShadowMap map({{box, at({0, 0, 0.5})}}, light, Eigen::Vector3d(0, 0, 0.65), 0.4);
   EXPECT_DOUBLE_EQ(map.lit_fraction({-0.15, 0.0, 0.8}), 0.0);   // behind the box along the ray
@@ -52,8 +42,8 @@ TEST(ShadowMap, ShadowFallsWhereTheLightRayHitsTheCaster) {
 
 TEST(ShadowMap, RenderDarkensShadowedPixelsOnly) {
   // The wall: a big box's front face at z = 0.8; the caster: a small box at 0.5 m.
-  const auto caster = make_box(0.05);
-  const auto wall = make_box(0.5);
+  const auto caster = make_cube(0.1);
+  const auto wall = make_cube(1.0);
   const kct::Pose wall_pose = at({0, 0, 1.3});  // front face at z = 0.8
   const Eigen::Vector3d light(0.5, 0.0, -1.0);
   const kct::ShadowMap map({{caster, at({0, 0, 0.5})}, {wall, wall_pose}}, light,

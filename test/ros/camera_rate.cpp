@@ -5,15 +5,8 @@
 // for the tracker. Asserted: at least ~min_status_ratio of the images sent got a ~status, and the
 // statuses plus the frames the nodelet reports as dropped before it account for every image.
 #include <gtest/gtest.h>
-#include <nodelet/NodeletLoad.h>
 #include <ros/ros.h>
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
-#include <sensor_msgs/CameraInfo.h>
-#include <sensor_msgs/Image.h>
-#include <geometry_msgs/PoseStamped.h>
 
-#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -23,50 +16,19 @@
 
 namespace {
 
-struct Frame {
-  sensor_msgs::Image::ConstPtr image;
-  sensor_msgs::CameraInfo::ConstPtr info;
-  geometry_msgs::PoseStamped::ConstPtr truth;
-};
-
-std::vector<Frame> read_bag(const std::string& path) {
-  std::map<ros::Time, Frame> by_stamp;
-  rosbag::Bag bag(path, rosbag::bagmode::Read);
-  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
-    if (auto image = m.instantiate<sensor_msgs::Image>()) by_stamp[image->header.stamp].image = image;
-    else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) by_stamp[info->header.stamp].info = info;
-    else if (auto pose = m.instantiate<geometry_msgs::PoseStamped>()) by_stamp[pose->header.stamp].truth = pose;
-  }
-  std::vector<Frame> frames;
-  for (const auto& entry : by_stamp) frames.push_back(entry.second);
-  return frames;
-}
-
 TEST(CameraRate, EveryImageSentAtTheCameraRateGetsAStatus) {
   ros::NodeHandle nh, private_nh("~");
   const std::string bag_path = private_nh.param<std::string>("bag", KCT_TEST_DATA_DIR "/small.bag");
   const double rate_hz = private_nh.param("rate_hz", 30.0);
   const double min_ratio = private_nh.param("min_status_ratio", 0.99);
   const int loops = private_nh.param("loops", 3);
-  const std::vector<Frame> frames = read_bag(bag_path);
+  const std::vector<BagFrame> frames = read_bag(bag_path);
   ASSERT_GE(frames.size(), 10u);
-  for (const Frame& f : frames) ASSERT_TRUE(f.image && f.info && f.truth);
+  for (const BagFrame& f : frames) ASSERT_TRUE(f.image && f.info && f.ground_truth);
 
   const std::string name = "/rate_tracker";  // default preset and queue: not set here
-  const geometry_msgs::Pose& first = frames.front().truth->pose;
-  nh.setParam(name + "/mesh_resource", std::string("file://") + KCT_SOURCE_DIR "/models/demo_crate.obj");
-  nh.setParam(name + "/initial_pose/position",
-              std::vector<double>{first.position.x, first.position.y, first.position.z});
-  nh.setParam(name + "/initial_pose/orientation",
-              std::vector<double>{first.orientation.x, first.orientation.y, first.orientation.z,
-                                  first.orientation.w});
-  ASSERT_TRUE(ros::service::waitForService("/manager/load_nodelet", 30000));
-  nodelet::NodeletLoad load;
-  load.request.name = name;
-  load.request.type = "klt_contour_tracker/TrackerNodelet";
-  load.request.remap_source_args = {"/image", "/camera_info"};
-  load.request.remap_target_args = {"/camera/image_raw", "/camera/camera_info"};
-  ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load) && load.response.success);
+  set_demo_crate_params(name, frames.front().ground_truth->pose);
+  ASSERT_TRUE(load_tracker_nodelet(name));
 
   std::mutex mutex;
   std::vector<klt_contour_tracker::TrackerStatus::ConstPtr> statuses;

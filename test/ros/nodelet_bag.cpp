@@ -4,16 +4,12 @@
 // processed, so that no frame can be dropped and the result does not depend on timing.
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
-#include <nodelet/NodeletLoad.h>
 #include <ros/ros.h>
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -35,30 +31,7 @@ double max_rotation_error_deg(const std::string& preset) { return preset == "klt
 // Generous: the first frame also builds the tracker (visibility table for the paper preset).
 const ros::WallDuration kFrameTimeout(120.0);
 
-struct BagFrame {
-  sensor_msgs::Image::ConstPtr image;
-  sensor_msgs::CameraInfo::ConstPtr info;
-  geometry_msgs::PoseStamped::ConstPtr ground_truth;
-};
-
 using klt_contour_tracker::from_pose_msg;
-
-std::vector<BagFrame> read_bag(const std::string& path) {
-  std::map<ros::Time, BagFrame> by_stamp;
-  rosbag::Bag bag(path, rosbag::bagmode::Read);
-  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
-    if (auto image = m.instantiate<sensor_msgs::Image>()) {
-      by_stamp[image->header.stamp].image = image;
-    } else if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
-      by_stamp[info->header.stamp].info = info;
-    } else if (auto pose = m.instantiate<geometry_msgs::PoseStamped>()) {
-      by_stamp[pose->header.stamp].ground_truth = pose;
-    }
-  }
-  std::vector<BagFrame> frames;
-  for (const auto& entry : by_stamp) frames.push_back(entry.second);
-  return frames;
-}
 
 class Recorder {
  public:
@@ -107,22 +80,10 @@ TEST(NodeletBag, PublishesAnAccuratePoseForEveryFrame) {
   // Configure and load the nodelet: name /klt_contour_tracker, camera in /camera.
   const std::string name = "/klt_contour_tracker";
   const geometry_msgs::Pose& first = frames.front().ground_truth->pose;
-  nh.setParam(name + "/mesh_resource", std::string("file://") + KCT_SOURCE_DIR "/models/demo_crate.obj");
   nh.setParam(name + "/preset", preset);
   nh.setParam(name + "/queue_size", 5);
-  nh.setParam(name + "/initial_pose/position",
-              std::vector<double>{first.position.x, first.position.y, first.position.z});
-  nh.setParam(name + "/initial_pose/orientation",
-              std::vector<double>{first.orientation.x, first.orientation.y, first.orientation.z,
-                                  first.orientation.w});
-  ASSERT_TRUE(ros::service::waitForService("/manager/load_nodelet", 30000));
-  nodelet::NodeletLoad load;
-  load.request.name = name;
-  load.request.type = "klt_contour_tracker/TrackerNodelet";
-  load.request.remap_source_args = {"/image", "/camera_info"};
-  load.request.remap_target_args = {"/camera/image_raw", "/camera/camera_info"};
-  ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load));
-  ASSERT_TRUE(load.response.success);
+  set_demo_crate_params(name, first);
+  ASSERT_TRUE(load_tracker_nodelet(name));
 
   Recorder recorder;
   ros::Subscriber pose_sub = nh.subscribe(name + "/pose", 100, &Recorder::on_pose, &recorder);

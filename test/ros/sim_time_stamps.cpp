@@ -6,8 +6,6 @@
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/Marker.h>
@@ -51,18 +49,11 @@ TEST(SimTime, EveryOutputIsStampedWithItsImageStamp) {
   std::set<ros::Time> image_stamps;
   geometry_msgs::Pose first_truth;
   bool have_truth = false;
-  {
-    rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
-    ros::Time first_stamp;
-    for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
-      if (auto image = m.instantiate<sensor_msgs::Image>()) image_stamps.insert(image->header.stamp);
-      if (auto pose = m.instantiate<geometry_msgs::PoseStamped>()) {
-        if (!have_truth || pose->header.stamp < first_stamp) {
-          first_truth = pose->pose;
-          first_stamp = pose->header.stamp;
-          have_truth = true;
-        }
-      }
+  for (const BagFrame& frame : read_bag(bag_path)) {  // in stamp order
+    if (frame.image) image_stamps.insert(frame.image->header.stamp);
+    if (frame.ground_truth && !have_truth) {
+      first_truth = frame.ground_truth->pose;
+      have_truth = true;
     }
   }
   ASSERT_GE(image_stamps.size(), 10u);

@@ -103,13 +103,7 @@ class Harness {
   Harness(const std::string& name, const std::map<std::string, XmlRpc::XmlRpcValue>& params)
       : name_("/" + name), nh_() {
     for (const auto& [key, value] : params) nh_.setParam(name_ + "/" + key, value);
-    EXPECT_TRUE(ros::service::waitForService("/manager/load_nodelet", 30000));
-    nodelet::NodeletLoad load;
-    load.request.name = name_;
-    load.request.type = "klt_contour_tracker/TrackerNodelet";
-    load.request.remap_source_args = {"/image", "/camera_info"};
-    load.request.remap_target_args = {name_ + "_camera/image_raw", name_ + "_camera/camera_info"};
-    loaded_ = ros::service::call("/manager/load_nodelet", load) && load.response.success;
+    loaded_ = load_tracker_nodelet(name_, name_ + "_camera");
     pose_sub_ = nh_.subscribe(name_ + "/pose", 100, &Harness::on_pose, this);
     covariance_sub_ = nh_.subscribe(name_ + "/pose_with_covariance", 100, &Harness::on_covariance, this);
     status_sub_ = nh_.subscribe(name_ + "/status", 100, &Harness::on_status, this);

@@ -108,6 +108,12 @@ class ContourExtractor {
   EdgeType edge_type(const EdgeInfo& e, const State& state) const;
   /// Fills face_state_: bit 0 front-facing, bit 1 front-facing and not in S.
   void compute_face_states(const Pose& object_to_camera) const;
+  /// The visibility table's bits of the faces hidden from a camera centred at `camera_object`
+  /// (object frame, m), cached per icosphere face; null without a table.
+  const std::uint64_t* invisible_bits(const Eigen::Vector3d& camera_object) const;
+  /// Face f's kFront / kFrontVisible bits for that camera (`invisible` from invisible_bits()).
+  std::uint8_t face_state(int f, const Eigen::Vector3d& camera_object,
+                          const std::uint64_t* invisible) const;
   /// Selects candidates_ for camera centres within candidate_radius_ of `camera_object`.
   void rebuild_candidates(const Eigen::Vector3d& camera_object) const;
 
