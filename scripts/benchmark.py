@@ -36,8 +36,18 @@ SECTIONS = ["hard", "real", "opt"]  # page order: the hard section first
 # ABLATIONS (it runs only when its preset exists), or on the command line with --variant.
 # ---------------------------------------------------------------------------------------------
 DEFAULT_PRESETS = ["realtime", "paper", "klt_only"]  # those that exist in the build are run
-ABLATIONS = [
-    # ("realtime_no_region", "realtime", {"region_weight": "0"}),  # label, preset, --param overrides
+ABLATIONS = [  # label, preset, --param overrides: the default with and without each of its cues
+    # the session's colour model (loss detection + whole-frame search while lost) off
+    ("realtime_no_color", "realtime", {"color_search": "false"}),
+    # PnP poses far from the expected pose accepted (as paper / klt_only)
+    ("realtime_no_motion_bounds", "realtime",
+     {"keypoint_max_motion_deg": "0", "keypoint_max_motion_diameters": "0"}),
+    # keypoints re-anchored only when the refinement moved them by <= 0.5 px (as paper)
+    ("realtime_strict_reanchor", "realtime", {"redetect_max_reprojection_increase_px": "0.5"}),
+    # cues that exist but are off by default (measured worse; shown so that it stays visible)
+    ("realtime_region", "realtime", {"region_weight": "1"}),
+    ("realtime_motion_model", "realtime",
+     {"motion_model": "true", "motion_prior_weight": "1", "keypoint_motion_gate_sigmas": "3"}),
 ]
 
 # ---------------------------------------------------------------------------------------------
