@@ -59,6 +59,22 @@ ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchS
   center_object_ = mesh_->bounding_box_center();
 }
 
+bool ObjectSearch::looks_grey(const cv::Mat& bgr) {
+  if (bgr.type() != CV_8UC3 || bgr.empty()) return true;
+  const int step_r = std::max(1, bgr.rows / 48), step_c = std::max(1, bgr.cols / 64);
+  int samples = 0, coloured = 0;
+  for (int r = 0; r < bgr.rows; r += step_r) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(r);
+    for (int c = 0; c < bgr.cols; c += step_c) {
+      const cv::Vec3b& p = row[c];
+      const int spread = std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]});
+      ++samples;
+      if (spread > 8) ++coloured;
+    }
+  }
+  return coloured * 50 < samples;  // < 2 %
+}
+
 int ObjectSearch::halvings(int width) const {
   int steps = 0;
   while (width > settings_.working_width_px && steps < 8) {

@@ -73,7 +73,8 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
   if (color.valid && result.status != TrackStatus::kInitialized) {
     constexpr double kMinVisibleFraction = 0.1;  // the object cannot be tracked out of view
     const bool out_of_view = color.visible_fraction < kMinVisibleFraction;
-    const bool faded = color.visible_fraction >= 0.3 && has_color_level_ && color_level_ > 0.0 &&
+    const bool faded = color.visible_fraction >= 0.3 && has_color_level_ &&
+                       color_level_ >= kMinColorLevel &&
                        color.contrast < color_lost_ratio * color_level_;
     if (out_of_view || faded) {
       last_good_ = false;

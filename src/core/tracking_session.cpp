@@ -65,7 +65,8 @@ void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
 TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched) {
   searched = false;
   const Pose& last_good = monitor_.last_good_pose();
-  if (search_ && search_->ready() && !bgr.empty() && monitor_.color_level() > 0.0) {
+  if (search_ && search_->ready() && !bgr.empty() &&
+      monitor_.color_level() >= TrackQualityMonitor::kMinColorLevel) {
     // Hypotheses: the best colour placements, each at the last good rotation and turned by
     // +-color_search_rotation_deg about the camera axes (the object may have turned while it
     // was hidden), plus the last good pose; each refined, the best colour contrast wins.
@@ -153,7 +154,8 @@ SessionResult TrackingSession::track(const Frame& frame) {
   // The colour frame, when the colour model is on and the frame is in colour (checked first:
   // an invalid frame is the tracker's to report).
   cv::Mat bgr;
-  if (search_ && frame.image.type() == CV_8UC3 && frame.image.size() == tracker_->camera().size())
+  if (search_ && frame.image.type() == CV_8UC3 && frame.image.size() == tracker_->camera().size() &&
+      !ObjectSearch::looks_grey(frame.image))
     bgr = tracker_->undistorted_color(frame.image);
   result.frame = result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
   use_colors(bgr, result);

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 #include "klt_contour_tracker/core/object_search.h"
 #include "synthetic_scene.h"
@@ -113,6 +114,15 @@ TEST_F(ObjectSearchTest, FindsAnObjectEnteringTheImage) {
   const Eigen::Vector2d true_px = camera_.project(entering * mesh_->bounding_box_center());
   EXPECT_LT((found_px - true_px).norm(), 8.0);
   EXPECT_LT(found.front().visible_fraction, 0.9);
+}
+
+TEST_F(ObjectSearchTest, GreyFramesStoredAsColourAreRecognized) {
+  const cv::Mat colour = frame_at(test::make_pose(0.4));
+  EXPECT_FALSE(ObjectSearch::looks_grey(colour));
+  cv::Mat grey, grey_bgr;
+  cv::cvtColor(colour, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey, grey_bgr, cv::COLOR_GRAY2BGR);
+  EXPECT_TRUE(ObjectSearch::looks_grey(grey_bgr));
 }
 
 TEST(ObjectSearchSettings, RejectsBadValues) {

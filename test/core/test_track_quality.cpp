@@ -88,6 +88,22 @@ TEST(TrackQuality, ColourEvidenceMakesAFrameBadWhenTheOutlineStopsSeparatingTheC
   EXPECT_TRUE(monitor.last_good());
 }
 
+TEST(TrackQuality, AWeakColourModelIsNotEvidence) {
+  TrackQualityParams params;
+  params.energy_level_smoothing = 1.0;
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  ColorEvidence color;
+  color.valid = true;
+  color.contrast = 0.15;  // below kMinColorLevel at a good pose: the colours barely differ
+  monitor.update(refined_result(10.0, true, 1.0), color, 0.6);
+  ASSERT_TRUE(monitor.last_good());
+  ASSERT_LT(monitor.color_level(), TrackQualityMonitor::kMinColorLevel);
+  color.contrast = 0.0;  // would be "faded" with a useful model
+  monitor.update(refined_result(10.0, true, 1.0), color, 0.6);
+  EXPECT_TRUE(monitor.last_good());
+}
+
 TEST(TrackQuality, LostAfterTheStatedBadFramesAndRecoversAfterTheStatedGoodFrames) {
   TrackQualityParams params;
   params.lost_after_bad_frames = 3;

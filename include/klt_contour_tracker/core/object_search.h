@@ -72,6 +72,11 @@ class ObjectSearch {
 
   const ObjectSearchSettings& settings() const { return settings_; }
 
+  /// True when a CV_8UC3 image carries no colour (a grey camera's frames stored as BGR: fewer
+  /// than 2 % of a grid of samples differ by more than 8 levels between channels): colour
+  /// statistics would only repeat the grey level, so the session does not use them.
+  static bool looks_grey(const cv::Mat& bgr);
+
  private:
   /// How often a frame of `width` is halved to reach working_width_px.
   int halvings(int width) const;

@@ -73,6 +73,9 @@ class TrackQualityMonitor {
                     double color_lost_ratio = 0.0);
   /// Running colour contrast of good frames (0 when none yet).
   double color_level() const { return color_level_; }
+  /// Colour evidence counts only once the running contrast is at least this: a model whose
+  /// outline separates the colours less at good poses tells too little to judge a frame by.
+  static constexpr double kMinColorLevel = 0.2;
 
   /// A pose was given to the tracker: TRACKING, counters cleared, the energy level forgotten.
   void on_initialized(const Pose& object_to_camera);
