@@ -129,32 +129,43 @@ bool ObjectSearch::learn(const cv::Mat& bgr, const Pose& object_to_camera,
 
 SearchCandidate ObjectSearch::score(const cv::Mat& bgr, const Pose& object_to_camera,
                                     const PinholeCamera& camera) const {
-  SearchCandidate result;
-  result.object_to_camera = object_to_camera;
-  if (!ready() || !(object_to_camera.translation().z() > 0)) return result;
+  return score(bgr, std::vector<Pose>{object_to_camera}, camera).front();
+}
+
+std::vector<SearchCandidate> ObjectSearch::score(const cv::Mat& bgr,
+                                                 const std::vector<Pose>& object_to_camera,
+                                                 const PinholeCamera& camera) const {
+  std::vector<SearchCandidate> results(object_to_camera.size());
+  for (std::size_t i = 0; i < results.size(); ++i) results[i].object_to_camera = object_to_camera[i];
+  if (!ready()) return results;
+  // The working image and its posterior are the same for every pose.
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
+  cv::Mat posterior;  // computed when the first pose needs it
   // Rendered on a canvas one image size larger on every side, to know how much of the
   // silhouette is outside the image.
   const int pad_x = small.cols, pad_y = small.rows;
   const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(),
                                     working_camera.cx() + pad_x, working_camera.cy() + pad_y,
                                     small.cols + 2 * pad_x, small.rows + 2 * pad_y);
+  const cv::Rect image_rect(pad_x, pad_y, small.cols, small.rows);
   RenderOptions options;
   options.draw_color = false;
-  const cv::Mat canvas = renderer_.render(object_to_camera, canvas_camera, options).mask();
-  const double total = cv::countNonZero(canvas);
-  if (total <= 0) return result;
-  const cv::Rect image_rect(pad_x, pad_y, small.cols, small.rows);
-  const cv::Mat mask = canvas(image_rect);
-  const double inside = cv::countNonZero(mask);
-  result.visible_fraction = inside / total;
-  if (result.visible_fraction < settings_.min_visible_fraction) return result;
-  const cv::Mat ring = ring_of(canvas, ring_width_px(canvas, settings_.ring_fraction))(image_rect);
-  if (cv::countNonZero(ring) == 0) return result;
-  const cv::Mat posterior = posterior_map(small);
-  result.contrast = cv::mean(posterior, mask)[0] - cv::mean(posterior, ring)[0];
-  return result;
+  for (SearchCandidate& result : results) {
+    if (!(result.object_to_camera.translation().z() > 0)) continue;
+    const cv::Mat canvas = renderer_.render(result.object_to_camera, canvas_camera, options).mask();
+    const double total = cv::countNonZero(canvas);
+    if (total <= 0) continue;
+    const cv::Mat mask = canvas(image_rect);
+    result.visible_fraction = cv::countNonZero(mask) / total;
+    if (result.visible_fraction < settings_.min_visible_fraction) continue;
+    const cv::Mat ring =
+        ring_of(canvas, ring_width_px(canvas, settings_.ring_fraction))(image_rect);
+    if (cv::countNonZero(ring) == 0) continue;
+    if (posterior.empty()) posterior = posterior_map(small);
+    result.contrast = cv::mean(posterior, mask)[0] - cv::mean(posterior, ring)[0];
+  }
+  return results;
 }
 
 std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose& reference,

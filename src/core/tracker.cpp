@@ -205,40 +205,60 @@ std::string Tracker::check_frame(const Frame& frame) const {
 
 TrackResult Tracker::refine_hypothesis(const Frame& frame, const Pose& around,
                                        double search_scale) {
+  return refine_hypotheses(frame, {around}, search_scale).front();
+}
+
+std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
+                                                    const std::vector<Pose>& around,
+                                                    double search_scale) {
   const auto start = std::chrono::steady_clock::now();
   if (!(search_scale >= 1.0) || !std::isfinite(search_scale))
     throw std::invalid_argument("Tracker::reacquire: search_scale must be >= 1");
-  if (!is_valid_pose(around) || around.translation().z() <= 0)
-    throw std::invalid_argument("Tracker::reacquire: pose is invalid or behind the camera");
-  TrackResult result;
-  result.message = check_frame(frame);
-  if (!result.message.empty()) {
-    result.status = TrackStatus::kInvalidInput;
-  } else {
-    result.status = TrackStatus::kReacquired;
-    result.object_to_camera = result.preliminary_object_to_camera = around;
-    if (params_.refine && refiner_) {
-      const cv::Mat gray = to_gray(frame.image);
-      TrackerParams widened = params_;
-      widened.extrapolated_rotation_bound_deg =
-          std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);
-      widened.extrapolated_axial_bound *= search_scale;
-      widened.extrapolated_lateral_bound *= search_scale;
-      refiner_->set_params(widened);  // only the box changes: nothing is rebuilt
-      RefineResult refined;
-      try {
-        refined = refiner_->refine(gray, camera_, around, nullptr);
-      } catch (...) {
-        refiner_->set_params(params_);
-        throw;
-      }
-      refiner_->set_params(params_);
-      apply_refinement(refined, result);
-    }
+  for (const Pose& pose : around)
+    if (!is_valid_pose(pose) || pose.translation().z() <= 0)
+      throw std::invalid_argument("Tracker::reacquire: pose is invalid or behind the camera");
+  const std::string message = check_frame(frame);
+  if (!message.empty()) {
+    TrackResult invalid;
+    invalid.status = TrackStatus::kInvalidInput;
+    invalid.message = message;
+    invalid.frame_time_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return std::vector<TrackResult>(around.size(), invalid);
   }
-  result.frame_time_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return result;
+  // The frame is converted once for every hypothesis; the search box is widened once.
+  const bool refine = params_.refine && refiner_;
+  const cv::Mat gray = refine ? to_gray(frame.image) : cv::Mat();
+  if (refine) {
+    TrackerParams widened = params_;
+    widened.extrapolated_rotation_bound_deg =
+        std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);
+    widened.extrapolated_axial_bound *= search_scale;
+    widened.extrapolated_lateral_bound *= search_scale;
+    refiner_->set_params(widened);  // only the box changes: nothing is rebuilt
+  }
+  std::vector<TrackResult> results;
+  results.reserve(around.size());
+  auto since = std::chrono::steady_clock::now();
+  try {
+    for (const Pose& pose : around) {
+      TrackResult result;
+      result.status = TrackStatus::kReacquired;
+      result.object_to_camera = result.preliminary_object_to_camera = pose;
+      if (refine) apply_refinement(refiner_->refine(gray, camera_, pose, nullptr), result);
+      const auto now = std::chrono::steady_clock::now();
+      // The first hypothesis also carries the shared checks and conversion.
+      result.frame_time_ms =
+          std::chrono::duration<double, std::milli>(now - (results.empty() ? start : since)).count();
+      since = now;
+      results.push_back(std::move(result));
+    }
+  } catch (...) {
+    if (refine) refiner_->set_params(params_);
+    throw;
+  }
+  if (refine) refiner_->set_params(params_);
+  return results;
 }
 
 void Tracker::adopt(const Frame& frame, TrackResult& result) {

@@ -91,19 +91,20 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
           hypotheses.push_back(turned);
         }
     }
-    TrackResult best;
-    double best_contrast = -2.0;
+    std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, hypotheses, 1.0);
+    if (refined.front().status != TrackStatus::kReacquired) return refined.front();  // invalid frame
+    std::vector<Pose> refined_poses;
     double time_ms = 0.0;
-    for (const Pose& hypothesis : hypotheses) {
-      TrackResult refined = tracker_->refine_hypothesis(frame, hypothesis, 1.0);
-      time_ms += refined.frame_time_ms;
-      if (refined.status != TrackStatus::kReacquired) return refined;  // invalid frame
-      const double contrast = search_->score(bgr, refined.object_to_camera, camera).contrast;
-      if (contrast > best_contrast) {
-        best_contrast = contrast;
-        best = refined;
-      }
+    for (const TrackResult& r : refined) {
+      refined_poses.push_back(r.object_to_camera);
+      time_ms += r.frame_time_ms;
     }
+    const std::vector<SearchCandidate> scored = search_->score(bgr, refined_poses, camera);
+    std::size_t best_index = 0;
+    for (std::size_t i = 1; i < scored.size(); ++i)
+      if (scored[i].contrast > scored[best_index].contrast) best_index = i;
+    TrackResult best = refined[best_index];
+    const double best_contrast = scored[best_index].contrast;
     if (best_contrast >= params_.color_accept_ratio * monitor_.color_level()) {
       searched = true;
       best.frame_time_ms = time_ms;

@@ -62,6 +62,10 @@ class ObjectSearch {
   /// when the model is not ready or less than min_visible_fraction of it is in the image).
   SearchCandidate score(const cv::Mat& bgr, const Pose& object_to_camera,
                         const PinholeCamera& camera) const;
+  /// score() for several poses in one frame (the working image and its posterior computed
+  /// once); one result per pose, in order.
+  std::vector<SearchCandidate> score(const cv::Mat& bgr, const std::vector<Pose>& object_to_camera,
+                                     const PinholeCamera& camera) const;
 
   /// Searches the whole frame: the rotation of `reference` (object_to_camera) at the depths
   /// depth_scales x its depth, placed anywhere its silhouette is at least min_visible_fraction

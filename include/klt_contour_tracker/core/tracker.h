@@ -7,6 +7,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "klt_contour_tracker/core/camera.h"
 #include "klt_contour_tracker/core/keypoint_tracker.h"
@@ -88,6 +89,10 @@ class Tracker {
   /// The refinement step of reacquire() alone: the track is not changed (to compare several
   /// re-acquisition hypotheses on one frame). Same exceptions as reacquire().
   TrackResult refine_hypothesis(const Frame& frame, const Pose& around, double search_scale);
+  /// refine_hypothesis() for several poses on one frame (converted once); one result per pose,
+  /// in order. All kInvalidInput when the frame is unusable.
+  std::vector<TrackResult> refine_hypotheses(const Frame& frame, const std::vector<Pose>& around,
+                                             double search_scale);
   /// The rest of reacquire(): tracking continues from `result` (a refine_hypothesis() result on
   /// `frame`; anything else is ignored), keypoints re-anchored there; adds the time to it.
   void adopt(const Frame& frame, TrackResult& result);
