@@ -44,6 +44,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
      {"keypoint_max_motion_deg": "0", "keypoint_max_motion_diameters": "0"}),
     # keypoints re-anchored only when the refinement moved them by <= 0.5 px (as paper)
     ("realtime_strict_reanchor", "realtime", {"redetect_max_reprojection_increase_px": "0.5"}),
+    # no search of image-plane shifts when KLT fails (the optimizer's basin only)
+    ("realtime_no_shift_search", "realtime", {"shift_search_diameters": "0"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     ("realtime_motion_model", "realtime",

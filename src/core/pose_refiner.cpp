@@ -188,9 +188,33 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
   settings.iterations_per_level = params_.iterations_per_level;
   const CoarseToFineOptimizer optimizer;
   // begin_frame() already ran in prepare_frame(): the optimizer must not repeat it.
-  const CoarseToFineResult optimized =
-      optimizer.minimize(costs_, cost_frame_, preliminary, radius_m_, settings, false);
-
+  // Starts: the preliminary pose and, without keypoints, the best image-plane shift of it
+  // (shift_search_diameters). Each is refined; the lowest final cost wins.
+  std::vector<Pose> starts{preliminary};
+  Pose shifted;
+  if (!cost_frame_.keypoints && params_.shift_search_diameters > 0.0 &&
+      search_shift(preliminary, &shifted))
+    starts.push_back(shifted);
+  CoarseToFineResult optimized;
+  int iterations = 0, evaluations = 0;
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    CoarseToFineResult run =
+        optimizer.minimize(costs_, cost_frame_, starts[i], radius_m_, settings, false);
+    iterations += run.iterations;
+    evaluations += run.evaluations;
+    if (i == 0 || run.final_cost < optimized.final_cost) {
+      optimized = run;
+    }
+  }
+  if (starts.size() > 1) {
+    // The winner's linearization (what energy() reads below), and the preliminary pose's cost
+    // under it (the acceptance test compares the two with the same contour).
+    costs_.linearize(optimized.object_to_camera, 0);
+    optimized.final_cost = costs_.evaluate(optimized.object_to_camera, nullptr, nullptr);
+    optimized.initial_cost = costs_.evaluate(preliminary, nullptr, nullptr);
+  }
+  optimized.iterations = iterations;
+  optimized.evaluations = evaluations;
   RefineResult result;
   result.hops = optimized.iterations;
   result.evaluations = optimized.evaluations;
@@ -226,6 +250,51 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
                         result.times.energy_ms);
   (void)start;
   return result;
+}
+
+bool PoseRefiner::search_shift(const Pose& preliminary, Pose* shifted) {
+  // An exhaustive search over a disc of shifts at the coarsest level (a few hundred to ~1300
+  // evaluations of Eq. 5 over <= kMaxSamples fixed points, no derivatives): cheaper and more
+  // predictable than widening the optimizer's basin, and only run when KLT gave no pose.
+  const int level = static_cast<int>(cost_frame_.levels.size()) - 1;
+  const PinholeCamera& camera = cost_frame_.levels[level].camera;
+  const Eigen::Vector3d center_camera = preliminary * center_object_;
+  if (!(center_camera.z() > 0.0)) return false;
+  contour_cost_->linearize(preliminary, level);
+  int base_count = 0;
+  const double base_energy = contour_cost_->energy(preliminary, &base_count);
+  if (base_count == 0) return false;
+  const double radius_px =
+      params_.shift_search_diameters * size_m_ * camera.fx() / center_camera.z();
+  constexpr int kMaxSteps = 20;  // at most a 41 x 41 grid (coarsest-level px steps otherwise)
+  const int steps = std::min(kMaxSteps, static_cast<int>(std::ceil(radius_px)));
+  if (steps < 1) return false;
+  const double step_px = radius_px / steps;
+  // A shift must clearly beat staying put (kMinGain x the energy): the object leaving the
+  // image or an occluder's edge otherwise lure the pose to whatever edges are near.
+  constexpr double kMinGain = 1.5;
+  double best_energy = kMinGain * base_energy;
+  Eigen::Vector3d best_shift = Eigen::Vector3d::Zero();
+  for (int j = -steps; j <= steps; ++j) {
+    for (int i = -steps; i <= steps; ++i) {
+      if ((i == 0 && j == 0) || i * i + j * j > steps * steps) continue;
+      const Eigen::Vector3d shift(i * step_px * center_camera.z() / camera.fx(),
+                                  j * step_px * center_camera.z() / camera.fy(), 0.0);
+      Pose candidate = preliminary;
+      candidate.translation() += shift;
+      int count = 0;
+      const double energy = contour_cost_->energy(candidate, &count);
+      // A shift that keeps too few of the points in the image (or the gradients' region of
+      // interest) is not comparable.
+      if (count < 0.7 * base_count || !(energy > best_energy)) continue;
+      best_energy = energy;
+      best_shift = shift;
+    }
+  }
+  if (best_shift.isZero()) return false;
+  *shifted = preliminary;
+  shifted->translation() += best_shift;
+  return true;
 }
 
 }  // namespace kct

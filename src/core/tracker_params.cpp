@@ -53,6 +53,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(max_image_pixels),
       KCT_FIELD(optimizer), KCT_FIELD(pyramid_levels), KCT_FIELD(iterations_per_level),
       KCT_FIELD(contour_weight), KCT_FIELD(keypoint_weight), KCT_FIELD(keypoint_sigma_px),
+      KCT_FIELD(shift_search_diameters),
       KCT_FIELD(num_threads),
 #undef KCT_FIELD
   };
@@ -169,6 +170,7 @@ void TrackerParams::validate() const {
   check_range("contour_weight", contour_weight, 0.0, 1e6);
   check_range("keypoint_weight", keypoint_weight, 0.0, 1e6);
   check_range("keypoint_sigma_px", keypoint_sigma_px, 0.01, 1000.0);
+  check_range("shift_search_diameters", shift_search_diameters, 0.0, 2.0);
   check_range("num_threads", num_threads, 1, 64);
 }
 
@@ -204,6 +206,9 @@ TrackerParams make_preset(const std::string& name) {
     // frame or a re-acquisition the contour corrects the pose and the new anchors follow it
     // (hard section: 9.89 -> 10.38 AUC).
     params.redetect_max_reprojection_increase_px = 2.0;
+    // When KLT fails, the refinement also starts from the best image-plane shift within 0.8
+    // object diameters (coarsest level): hard section 10.62 -> 10.86 mean AUC.
+    params.shift_search_diameters = 0.8;
     return params;
   }
   if (name == "klt_only") {

@@ -71,6 +71,37 @@ TEST_F(PoseRefinerTest, KeypointSearchAreaKeepsTheReprojectionBound) {
   EXPECT_LT(rotation_error_deg(result.object_to_camera, truth_), rotation_error_deg(pnp, truth_));
 }
 
+TEST_F(PoseRefinerTest, ShiftSearchFindsAnObjectThatMovedFarWhenKltFailed) {
+  // The object moved 0.35 diameters sideways (a fast hand-held move that defeats KLT): the
+  // coarse-to-fine optimizer's basin (a few coarsest-level px) does not reach it from the
+  // last pose; the shift search over 0.8 diameters does.
+  const double size = mesh_->diameter();
+  const Pose stale = test::move(truth_, 0.0, {0, 0, 1}, {0.35 * size * 0.8, 0.35 * size * 0.6, 0});
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 3;
+  params.shift_search_diameters = 0.0;
+  PoseRefiner without(mesh_, params);
+  const RefineResult stuck = without.refine(gray_, camera_, stale, nullptr);
+  // Tolerance: the test is meaningful only if the search is needed (the pose stays > 2 cm off).
+  EXPECT_GT(translation_error(stuck.object_to_camera, truth_), 0.02);
+  params.shift_search_diameters = 0.8;
+  PoseRefiner with(mesh_, params);
+  const RefineResult found = with.refine(gray_, camera_, stale, nullptr);
+  // Tolerance: 3 mm and 2 deg (coarse-to-fine accuracy on a 0.45 m distant box).
+  EXPECT_LT(translation_error(found.object_to_camera, truth_), 0.003);
+  EXPECT_LT(rotation_error_deg(found.object_to_camera, truth_), 2.0);
+}
+
+TEST_F(PoseRefinerTest, ShiftSearchKeepsAPoseThatIsAlreadyRight) {
+  // At the true pose no shift beats staying put 1.5 x: the pose is not lured to other edges.
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 3;
+  PoseRefiner refiner(mesh_, params);
+  ASSERT_GT(params.shift_search_diameters, 0.0);
+  const RefineResult result = refiner.refine(gray_, camera_, truth_, nullptr);
+  EXPECT_LT(translation_error(result.object_to_camera, truth_), 0.002);
+}
+
 TEST_F(PoseRefinerTest, SameSeedSameResult) {
   const Pose perturbed = test::move(truth_, 4.0, {0, 0, 1}, {0.0, 0.004, 0.0});
   PoseRefiner a(mesh_, params_), b(mesh_, params_);

@@ -88,6 +88,9 @@ class PoseRefiner {
 
   RefineResult refine_coarse_to_fine(const cv::Mat& gray, const PinholeCamera& camera,
                                      const Pose& preliminary, const KeypointResult* keypoints);
+  /// shift_search_diameters (see TrackerParams): the image-plane shift of `preliminary` with
+  /// the highest contour energy on the coarsest level, when it beats the unshifted pose.
+  bool search_shift(const Pose& preliminary, Pose* shifted);
   void build_cues();
   PoseCostFrame cost_frame_;
   PoseCostSum costs_;
