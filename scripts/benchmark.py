@@ -46,6 +46,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_strict_reanchor", "realtime", {"redetect_max_reprojection_increase_px": "0.5"}),
     # no search of image-plane shifts when KLT fails (the optimizer's basin only)
     ("realtime_no_shift_search", "realtime", {"shift_search_diameters": "0"}),
+    # re-acquisition takes only placements above color_accept_ratio (no two-frame confirmation)
+    ("realtime_no_confirm", "realtime", {"color_confirm_ratio": "0"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     ("realtime_motion_model", "realtime",

@@ -39,6 +39,7 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   frames_since_learning_ = 0;
   initialized_since_last_frame_ = true;
   lost_at_frame_ = -1;
+  unconfirmed_.reset();
 }
 
 void TrackingSession::reset() {
@@ -46,6 +47,7 @@ void TrackingSession::reset() {
   monitor_.reset();
   initialized_since_last_frame_ = false;
   lost_at_frame_ = -1;
+  unconfirmed_.reset();
 }
 
 void TrackingSession::set_params(const TrackerParams& params) {
@@ -105,7 +107,20 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       if (scored[i].contrast > scored[best_index].contrast) best_index = i;
     TrackResult best = refined[best_index];
     const double best_contrast = scored[best_index].contrast;
-    if (best_contrast >= params_.color_accept_ratio * monitor_.color_level()) {
+    // color_confirm_ratio: a weaker best hypothesis counts when the previous frame's best was at
+    // the same place.
+    bool confirmed = false;
+    if (params_.color_confirm_ratio > 0.0 &&
+        best_contrast >= params_.color_confirm_ratio * monitor_.color_level()) {
+      const Pose& pose = refined[best_index].object_to_camera;
+      confirmed = unconfirmed_ && ((*unconfirmed_ * center_object) - (pose * center_object)).norm() <
+                                      0.25 * mesh_->diameter();
+      unconfirmed_ = pose;
+    } else {
+      unconfirmed_.reset();
+    }
+    if (best_contrast >= params_.color_accept_ratio * monitor_.color_level() || confirmed) {
+      unconfirmed_.reset();
       searched = true;
       best.frame_time_ms = time_ms;
       tracker_->adopt(frame, best);
@@ -152,6 +167,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   initialized_since_last_frame_ = false;
 
   result.reacquiring = monitor_.should_reacquire();
+  if (!result.reacquiring) unconfirmed_.reset();
   // The colour frame, when the colour model is on and the frame is in colour (checked first:
   // an invalid frame is the tracker's to report).
   cv::Mat bgr;

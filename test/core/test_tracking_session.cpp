@@ -194,5 +194,59 @@ TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
   }
 }
 
+/// color_confirm_ratio: the object comes back far away with its colours washed out (as under
+/// blur or a partial occlusion), so that the best placement's contrast stays below
+/// color_accept_ratio x the learned level. Without confirmation the session never
+/// takes it; with it, the placement is taken once two frames agree, and not on the first frame.
+TEST(TrackingSession, WeakColourPlacementIsTakenWhenTwoFramesAgree) {
+  auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  mesh->base_color = cv::Vec3b(30, 40, 210);
+  const Renderer renderer(mesh);
+  const PinholeCamera camera = test::make_camera();
+  cv::Mat background = test::make_background(camera.size(), 5);
+  background = background * 0.5 + cv::Scalar(90, 70, 40);
+  const Pose start = test::make_pose(0.45);
+  const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {-0.16, 0.03, 0.0});
+  // The object's pixels blended 10 % with the background behind them (contrast about 0.85 x
+  // the learned level, measured), and an acceptance ratio above that.
+  const auto washed_frame = [&](int seed) {
+    const cv::Mat mask = renderer.render(away, camera).mask();
+    cv::Mat frame = test::render_frame(renderer, camera, away, background, 1.5, seed), blended;
+    cv::addWeighted(frame, 0.9, background, 0.1, 0.0, blended);
+    blended.copyTo(frame, mask);
+    return frame;
+  };
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 2;
+  params.visibility_resolution_px = 128;
+  params.visibility_cache_dir = "";
+  ASSERT_GT(params.color_confirm_ratio, 0.0) << "realtime confirms weak placements";
+  params.color_accept_ratio = 0.95;
+  for (const double confirm : {0.0, params.color_confirm_ratio}) {
+    params.color_confirm_ratio = confirm;
+    TrackingSession session(mesh, params);
+    session.set_camera(camera);
+    session.initialize(start);
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033)
+      session.track({test::render_frame(renderer, camera, start, background, 1.5, i), stamp});
+    for (int i = 0; i < 12; ++i, stamp += 0.033) session.track({background.clone(), stamp});
+    ASSERT_EQ(session.state(), TrackState::kLost);
+    int found_at = -1;
+    for (int i = 0; i < 10 && found_at < 0; ++i, stamp += 0.033) {
+      const SessionResult r = session.track({washed_frame(50 + i), stamp});
+      if (translation_error(r.frame.object_to_camera, away) < 0.01 &&
+          rotation_error_deg(r.frame.object_to_camera, away) < 3.0)
+        found_at = i;
+    }
+    if (confirm == 0.0) {
+      EXPECT_EQ(found_at, -1) << "the washed-out placement passed color_accept_ratio: no test";
+    } else {
+      EXPECT_GE(found_at, 1) << "taken on the first frame back: not confirmed";
+      EXPECT_LE(found_at, 3) << "not re-acquired within 4 frames (-1: never)";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace kct

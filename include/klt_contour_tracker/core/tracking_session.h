@@ -116,6 +116,8 @@ class TrackingSession {
   bool has_last_stamp_ = false;
   double last_stamp_s_ = 0.0;
   int lost_at_frame_ = -1;  ///< statistics_.frames when the current loss was declared
+  /// The previous frame's best re-acquisition hypothesis above color_confirm_ratio, if any.
+  std::optional<Pose> unconfirmed_;
   SessionStatistics statistics_;
 };
 
