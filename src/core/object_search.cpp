@@ -1,4 +1,5 @@
 #include "klt_contour_tracker/core/object_search.h"
+#include "klt_contour_tracker/core/check_range.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,12 +10,7 @@
 namespace kct {
 namespace {
 
-void check_range(const char* name, double value, double low, double high) {
-  if (!std::isfinite(value) || value < low || value > high)
-    throw std::invalid_argument(std::string("ObjectSearchSettings.") + name + " must be in [" +
-                                std::to_string(low) + ", " + std::to_string(high) + "], got " +
-                                std::to_string(value));
-}
+constexpr const char* kOwner = "ObjectSearchSettings";
 
 /// The ring around a silhouette mask: dilated by `ring_px` minus the mask.
 cv::Mat ring_of(const cv::Mat& mask, int ring_px) {
@@ -41,14 +37,14 @@ Pose placed_at(const Pose& reference, const Eigen::Vector3d& center_object,
 }  // namespace
 
 void ObjectSearchSettings::validate() const {
-  check_range("working_width_px", working_width_px, 32, 100000);
-  check_range("band_px", band_px, 1, 100);
-  check_range("learning_rate", learning_rate, 1e-6, 1.0);
+  check_range(kOwner, "working_width_px", working_width_px, 32, 100000);
+  check_range(kOwner, "band_px", band_px, 1, 100);
+  check_range(kOwner, "learning_rate", learning_rate, 1e-6, 1.0);
   if (depth_scales.empty())
     throw std::invalid_argument("ObjectSearchSettings.depth_scales must not be empty");
-  for (double s : depth_scales) check_range("depth_scales[i]", s, 0.05, 20.0);
-  check_range("min_visible_fraction", min_visible_fraction, 1e-3, 1.0);
-  check_range("ring_fraction", ring_fraction, 0.01, 2.0);
+  for (double s : depth_scales) check_range(kOwner, "depth_scales[i]", s, 0.05, 20.0);
+  check_range(kOwner, "min_visible_fraction", min_visible_fraction, 1e-3, 1.0);
+  check_range(kOwner, "ring_fraction", ring_fraction, 0.01, 2.0);
 }
 
 ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchSettings& settings)

@@ -1,4 +1,5 @@
 #include "klt_contour_tracker/core/track_quality.h"
+#include "klt_contour_tracker/core/check_range.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,12 +8,7 @@
 namespace kct {
 namespace {
 
-void check_range(const char* name, double value, double low, double high) {
-  if (!std::isfinite(value) || value < low || value > high)
-    throw std::invalid_argument(std::string("TrackQualityParams.") + name + " must be in [" +
-                                std::to_string(low) + ", " + std::to_string(high) + "], got " +
-                                std::to_string(value));
-}
+constexpr const char* kOwner = "TrackQualityParams";
 
 }  // namespace
 
@@ -26,12 +22,12 @@ const char* to_string(TrackState state) {
 }
 
 void TrackQualityParams::validate() const {
-  check_range("energy_weight", energy_weight, 0.0, 1.0);
-  check_range("min_quality", min_quality, 0.0, 1.0);
-  check_range("energy_level_smoothing", energy_level_smoothing, 1e-6, 1.0);
-  check_range("lost_after_bad_frames", lost_after_bad_frames, 1, 1000);
-  check_range("recover_after_good_frames", recover_after_good_frames, 1, 1000);
-  check_range("reacquire_search_scale", reacquire_search_scale, 1.0, 10.0);
+  check_range(kOwner, "energy_weight", energy_weight, 0.0, 1.0);
+  check_range(kOwner, "min_quality", min_quality, 0.0, 1.0);
+  check_range(kOwner, "energy_level_smoothing", energy_level_smoothing, 1e-6, 1.0);
+  check_range(kOwner, "lost_after_bad_frames", lost_after_bad_frames, 1, 1000);
+  check_range(kOwner, "recover_after_good_frames", recover_after_good_frames, 1, 1000);
+  check_range(kOwner, "reacquire_search_scale", reacquire_search_scale, 1.0, 10.0);
 }
 
 TrackQualityMonitor::TrackQualityMonitor(const TrackQualityParams& params) : params_(params) {

@@ -1,4 +1,5 @@
 #include "klt_contour_tracker/core/tracker_params.h"
+#include "klt_contour_tracker/core/check_range.h"
 
 #include <cmath>
 #include <sstream>
@@ -9,15 +10,7 @@
 namespace kct {
 namespace {
 
-template <typename T>
-void check_range(const char* name, T value, T lo, T hi) {
-  if (!(value >= lo && value <= hi)) {  // also rejects NaN
-    std::ostringstream msg;
-    msg << "TrackerParams." << name << " = " << value << " is outside the allowed range [" << lo
-        << ", " << hi << "]";
-    throw std::invalid_argument(msg.str());
-  }
-}
+constexpr const char* kOwner = "TrackerParams";
 
 // One entry per field: its name and a pointer to it. Keeps set_param() and describe() in
 // step with the struct without a hand-written if-chain per use.
@@ -107,73 +100,73 @@ std::vector<std::pair<std::string, std::string>> describe(const TrackerParams& p
 }
 
 void TrackerParams::validate() const {
-  check_range("max_keypoints", max_keypoints, 8, 100000);
-  check_range("corner_quality_level", corner_quality_level, 1e-6, 1.0);
-  check_range("corner_min_distance_px", corner_min_distance_px, 0.0, 1000.0);
-  check_range("klt_window_px", klt_window_px, 5, 201);
+  check_range(kOwner, "max_keypoints", max_keypoints, 8, 100000);
+  check_range(kOwner, "corner_quality_level", corner_quality_level, 1e-6, 1.0);
+  check_range(kOwner, "corner_min_distance_px", corner_min_distance_px, 0.0, 1000.0);
+  check_range(kOwner, "klt_window_px", klt_window_px, 5, 201);
   if (klt_window_px % 2 == 0)
     throw std::invalid_argument("TrackerParams.klt_window_px must be odd");
-  check_range("klt_pyramid_levels", klt_pyramid_levels, 0, 8);
-  check_range("klt_forward_backward_px", klt_forward_backward_px, 0.01, 100.0);
-  check_range("klt_illumination_window_px", klt_illumination_window_px, 0, 501);
-  check_range("klt_max_image_width_px", klt_max_image_width_px, 0, 100000);
-  check_range("ransac_reprojection_px", ransac_reprojection_px, 0.1, 100.0);
-  check_range("ransac_iterations", ransac_iterations, 1, 100000);
-  check_range("klt_min_points", klt_min_points, 4, 100000);
-  check_range("klt_min_inlier_ratio", klt_min_inlier_ratio, 0.0, 1.0);
-  check_range("redetect_ratio", redetect_ratio, 0.0, 1.0);
-  check_range("redetect_interval_frames", redetect_interval_frames, 0, 1000000);
-  check_range("redetect_max_reprojection_increase_px", redetect_max_reprojection_increase_px, 0.0,
+  check_range(kOwner, "klt_pyramid_levels", klt_pyramid_levels, 0, 8);
+  check_range(kOwner, "klt_forward_backward_px", klt_forward_backward_px, 0.01, 100.0);
+  check_range(kOwner, "klt_illumination_window_px", klt_illumination_window_px, 0, 501);
+  check_range(kOwner, "klt_max_image_width_px", klt_max_image_width_px, 0, 100000);
+  check_range(kOwner, "ransac_reprojection_px", ransac_reprojection_px, 0.1, 100.0);
+  check_range(kOwner, "ransac_iterations", ransac_iterations, 1, 100000);
+  check_range(kOwner, "klt_min_points", klt_min_points, 4, 100000);
+  check_range(kOwner, "klt_min_inlier_ratio", klt_min_inlier_ratio, 0.0, 1.0);
+  check_range(kOwner, "redetect_ratio", redetect_ratio, 0.0, 1.0);
+  check_range(kOwner, "redetect_interval_frames", redetect_interval_frames, 0, 1000000);
+  check_range(kOwner, "redetect_max_reprojection_increase_px", redetect_max_reprojection_increase_px, 0.0,
               1e6);
-  check_range("keypoint_max_motion_diameters", keypoint_max_motion_diameters, 0.0, 1e3);
-  check_range("keypoint_max_motion_deg", keypoint_max_motion_deg, 0.0, 180.0);
-  check_range("keypoint_mask_erosion_px", keypoint_mask_erosion_px, 0, 100);
-  check_range("color_learn_interval_frames", color_learn_interval_frames, 1, 100000);
-  check_range("color_lost_ratio", color_lost_ratio, 0.0, 1.0);
-  check_range("color_accept_ratio", color_accept_ratio, 0.0, 1.0);
-  check_range("color_search_placements", color_search_placements, 1, 5);
-  check_range("color_search_rotation_deg", color_search_rotation_deg, 0.0, 90.0);
-  check_range("color_confirm_ratio", color_confirm_ratio, 0.0, 1.0);
-  check_range("motion_velocity_smoothing", motion_velocity_smoothing, 1e-6, 1.0);
-  check_range("motion_error_smoothing", motion_error_smoothing, 1e-6, 1.0);
-  check_range("keypoint_motion_gate_sigmas", keypoint_motion_gate_sigmas, 0.0, 1000.0);
-  check_range("motion_prior_weight", motion_prior_weight, 0.0, 1e6);
-  check_range("region_weight", region_weight, 0.0, 1e6);
-  check_range("region_line_half_length_px", region_line_half_length_px, 2, 100);
-  check_range("region_line_spacing_px", region_line_spacing_px, 0.5, 100.0);
-  check_range("region_band_px", region_band_px, 1, 100);
-  check_range("region_learning_rate", region_learning_rate, 1e-6, 1.0);
-  check_range("sharp_edge_angle_deg", sharp_edge_angle_deg, 0.0, 180.0);
-  check_range("icosphere_subdivisions", icosphere_subdivisions, 0, 6);
-  check_range("visibility_resolution_px", visibility_resolution_px, 16, 4096);
-  check_range("contour_sample_spacing_px", contour_sample_spacing_px, 0.1, 100.0);
-  check_range("blur_sigma_px", blur_sigma_px, 0.0, 20.0);
-  check_range("final_hops", final_hops, 0, 10000);
-  check_range("hops_budget", hops_budget, 1.0, 1e12);
-  check_range("min_hops_cap", min_hops_cap, 0, 100000);
-  check_range("max_hops_without_improvement_cap", max_hops_without_improvement_cap, 1, 100000);
-  check_range("max_hops_cap", max_hops_cap, 1, 100000);
+  check_range(kOwner, "keypoint_max_motion_diameters", keypoint_max_motion_diameters, 0.0, 1e3);
+  check_range(kOwner, "keypoint_max_motion_deg", keypoint_max_motion_deg, 0.0, 180.0);
+  check_range(kOwner, "keypoint_mask_erosion_px", keypoint_mask_erosion_px, 0, 100);
+  check_range(kOwner, "color_learn_interval_frames", color_learn_interval_frames, 1, 100000);
+  check_range(kOwner, "color_lost_ratio", color_lost_ratio, 0.0, 1.0);
+  check_range(kOwner, "color_accept_ratio", color_accept_ratio, 0.0, 1.0);
+  check_range(kOwner, "color_search_placements", color_search_placements, 1, 5);
+  check_range(kOwner, "color_search_rotation_deg", color_search_rotation_deg, 0.0, 90.0);
+  check_range(kOwner, "color_confirm_ratio", color_confirm_ratio, 0.0, 1.0);
+  check_range(kOwner, "motion_velocity_smoothing", motion_velocity_smoothing, 1e-6, 1.0);
+  check_range(kOwner, "motion_error_smoothing", motion_error_smoothing, 1e-6, 1.0);
+  check_range(kOwner, "keypoint_motion_gate_sigmas", keypoint_motion_gate_sigmas, 0.0, 1000.0);
+  check_range(kOwner, "motion_prior_weight", motion_prior_weight, 0.0, 1e6);
+  check_range(kOwner, "region_weight", region_weight, 0.0, 1e6);
+  check_range(kOwner, "region_line_half_length_px", region_line_half_length_px, 2, 100);
+  check_range(kOwner, "region_line_spacing_px", region_line_spacing_px, 0.5, 100.0);
+  check_range(kOwner, "region_band_px", region_band_px, 1, 100);
+  check_range(kOwner, "region_learning_rate", region_learning_rate, 1e-6, 1.0);
+  check_range(kOwner, "sharp_edge_angle_deg", sharp_edge_angle_deg, 0.0, 180.0);
+  check_range(kOwner, "icosphere_subdivisions", icosphere_subdivisions, 0, 6);
+  check_range(kOwner, "visibility_resolution_px", visibility_resolution_px, 16, 4096);
+  check_range(kOwner, "contour_sample_spacing_px", contour_sample_spacing_px, 0.1, 100.0);
+  check_range(kOwner, "blur_sigma_px", blur_sigma_px, 0.0, 20.0);
+  check_range(kOwner, "final_hops", final_hops, 0, 10000);
+  check_range(kOwner, "hops_budget", hops_budget, 1.0, 1e12);
+  check_range(kOwner, "min_hops_cap", min_hops_cap, 0, 100000);
+  check_range(kOwner, "max_hops_without_improvement_cap", max_hops_without_improvement_cap, 1, 100000);
+  check_range(kOwner, "max_hops_cap", max_hops_cap, 1, 100000);
   if (min_hops_cap > max_hops_cap)
     throw std::invalid_argument("TrackerParams.min_hops_cap must be <= max_hops_cap");
-  check_range("max_reprojection_increase_px", max_reprojection_increase_px, 0.0, 1000.0);
-  check_range("extrapolated_rotation_bound_deg", extrapolated_rotation_bound_deg, 0.0, 180.0);
-  check_range("extrapolated_axial_bound", extrapolated_axial_bound, 0.0, 10.0);
-  check_range("extrapolated_lateral_bound", extrapolated_lateral_bound, 0.0, 10.0);
-  check_range("hop_rotation_deg", hop_rotation_deg, 0.0, 180.0);
-  check_range("hop_translation", hop_translation, 0.0, 10.0);
-  check_range("metropolis_temperature", metropolis_temperature, 1e-9, 1e9);
-  check_range("slsqp_max_evaluations", slsqp_max_evaluations, 1, 1000000);
-  check_range("max_image_pixels", max_image_pixels, 32 * 32, 16384 * 16384);
+  check_range(kOwner, "max_reprojection_increase_px", max_reprojection_increase_px, 0.0, 1000.0);
+  check_range(kOwner, "extrapolated_rotation_bound_deg", extrapolated_rotation_bound_deg, 0.0, 180.0);
+  check_range(kOwner, "extrapolated_axial_bound", extrapolated_axial_bound, 0.0, 10.0);
+  check_range(kOwner, "extrapolated_lateral_bound", extrapolated_lateral_bound, 0.0, 10.0);
+  check_range(kOwner, "hop_rotation_deg", hop_rotation_deg, 0.0, 180.0);
+  check_range(kOwner, "hop_translation", hop_translation, 0.0, 10.0);
+  check_range(kOwner, "metropolis_temperature", metropolis_temperature, 1e-9, 1e9);
+  check_range(kOwner, "slsqp_max_evaluations", slsqp_max_evaluations, 1, 1000000);
+  check_range(kOwner, "max_image_pixels", max_image_pixels, 32 * 32, 16384 * 16384);
   if (optimizer != "basin_hopping" && optimizer != "coarse_to_fine")
     throw std::invalid_argument("TrackerParams.optimizer = '" + optimizer.substr(0, 40) +
                                 "' is not one of basin_hopping, coarse_to_fine");
-  check_range("pyramid_levels", pyramid_levels, 1, 6);
-  check_range("iterations_per_level", iterations_per_level, 1, 1000);
-  check_range("contour_weight", contour_weight, 0.0, 1e6);
-  check_range("keypoint_weight", keypoint_weight, 0.0, 1e6);
-  check_range("keypoint_sigma_px", keypoint_sigma_px, 0.01, 1000.0);
-  check_range("shift_search_diameters", shift_search_diameters, 0.0, 2.0);
-  check_range("num_threads", num_threads, 1, 64);
+  check_range(kOwner, "pyramid_levels", pyramid_levels, 1, 6);
+  check_range(kOwner, "iterations_per_level", iterations_per_level, 1, 1000);
+  check_range(kOwner, "contour_weight", contour_weight, 0.0, 1e6);
+  check_range(kOwner, "keypoint_weight", keypoint_weight, 0.0, 1e6);
+  check_range(kOwner, "keypoint_sigma_px", keypoint_sigma_px, 0.01, 1000.0);
+  check_range(kOwner, "shift_search_diameters", shift_search_diameters, 0.0, 2.0);
+  check_range(kOwner, "num_threads", num_threads, 1, 64);
 }
 
 std::vector<std::string> preset_names() { return {"realtime", "paper", "klt_only"}; }
