@@ -112,9 +112,9 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     bool confirmed = false;
     if (params_.color_confirm_ratio > 0.0 &&
         best_contrast >= params_.color_confirm_ratio * monitor_.color_level()) {
-      const Pose& pose = refined[best_index].object_to_camera;
+      const Pose& pose = best.object_to_camera;
       confirmed = unconfirmed_ && ((*unconfirmed_ * center_object) - (pose * center_object)).norm() <
-                                      0.25 * mesh_->diameter();
+                                      0.25 * tracker_->diameter_m();
       unconfirmed_ = pose;
     } else {
       unconfirmed_.reset();
