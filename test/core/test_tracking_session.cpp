@@ -150,22 +150,41 @@ TEST(TrackingSession, ResetWaitsForAPoseAndInvalidFramesChangeNothing) {
 namespace kct {
 namespace {
 
-/// The colour search of the realtime preset (color_search): a red box over a textured blue-grey
-/// background is hidden, then shown again 12 cm to the side and 8 deg turned, far outside the
-/// local refinement's reach; the session must find it again within 10 frames.
-TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
-  auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
-  mesh->base_color = cv::Vec3b(30, 40, 210);
-  const Renderer renderer(mesh);
-  const PinholeCamera camera = test::make_camera();
-  cv::Mat background = test::make_background(camera.size(), 5);
-  background = background * 0.5 + cv::Scalar(90, 70, 40);  // blue-grey, unlike the box
-  const Pose start = test::make_pose(0.45);
-  const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
+TrackerParams quick_realtime() {
   TrackerParams params = make_preset("realtime");
   params.icosphere_subdivisions = 2;
   params.visibility_resolution_px = 128;
   params.visibility_cache_dir = "";
+  return params;
+}
+
+/// The colour tests' scene: a red box over a blue-grey textured background (unlike the box).
+struct ColourScene {
+  std::shared_ptr<Mesh> mesh = red_box();
+  Renderer renderer{mesh};
+  PinholeCamera camera = test::make_camera();
+  cv::Mat background = test::make_background(camera.size(), 5) * 0.5 + cv::Scalar(90, 70, 40);
+  Pose start = test::make_pose(0.45);
+
+  static std::shared_ptr<Mesh> red_box() {
+    auto box = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+    box->base_color = cv::Vec3b(30, 40, 210);
+    return box;
+  }
+};
+
+/// The colour search of the realtime preset (color_search): a red box over a textured blue-grey
+/// background is hidden, then shown again 12 cm to the side and 8 deg turned, far outside the
+/// local refinement's reach; the session must find it again within 10 frames.
+TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
+  const ColourScene scene;
+  const auto& mesh = scene.mesh;
+  const Renderer& renderer = scene.renderer;
+  const PinholeCamera& camera = scene.camera;
+  const cv::Mat& background = scene.background;
+  const Pose& start = scene.start;
+  const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
+  TrackerParams params = quick_realtime();
   for (const bool with_search : {false, true}) {
     params.color_search = with_search;
     TrackingSession session(mesh, params);
@@ -199,13 +218,12 @@ TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
 /// color_accept_ratio x the learned level. Without confirmation the session never
 /// takes it; with it, the placement is taken once two frames agree, and not on the first frame.
 TEST(TrackingSession, WeakColourPlacementIsTakenWhenTwoFramesAgree) {
-  auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
-  mesh->base_color = cv::Vec3b(30, 40, 210);
-  const Renderer renderer(mesh);
-  const PinholeCamera camera = test::make_camera();
-  cv::Mat background = test::make_background(camera.size(), 5);
-  background = background * 0.5 + cv::Scalar(90, 70, 40);
-  const Pose start = test::make_pose(0.45);
+  const ColourScene scene;
+  const auto& mesh = scene.mesh;
+  const Renderer& renderer = scene.renderer;
+  const PinholeCamera& camera = scene.camera;
+  const cv::Mat& background = scene.background;
+  const Pose& start = scene.start;
   const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {-0.16, 0.03, 0.0});
   // The object's pixels blended 10 % with the background behind them (contrast about 0.85 x
   // the learned level, measured), and an acceptance ratio above that.
@@ -216,10 +234,7 @@ TEST(TrackingSession, WeakColourPlacementIsTakenWhenTwoFramesAgree) {
     blended.copyTo(frame, mask);
     return frame;
   };
-  TrackerParams params = make_preset("realtime");
-  params.icosphere_subdivisions = 2;
-  params.visibility_resolution_px = 128;
-  params.visibility_cache_dir = "";
+  TrackerParams params = quick_realtime();
   ASSERT_GT(params.color_confirm_ratio, 0.0) << "realtime confirms weak placements";
   params.color_accept_ratio = 0.95;
   for (const double confirm : {0.0, params.color_confirm_ratio}) {
