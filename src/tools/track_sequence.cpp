@@ -31,7 +31,7 @@ void usage(const char* error) {
   std::cerr << "usage: track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]\n"
                "                      [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]\n"
                "                      [--max-frames N] [--max-image-pixels N] [--errors FILE]\n"
-               "                      [--debug-dir DIR [--debug-every N]] [--quiet]\n"
+               "                      [--debug-dir DIR [--debug-every N]] [--trace FILE] [--quiet]\n"
                "  --model-scale S: metres per model unit (0.001 for millimetres). It applies to\n"
                "  everything in model units: the mesh, pose.txt as read, the poses written by --output\n"
                "  (in model units, as read). Errors and ADD are reported in metres / mm regardless.\n"
@@ -42,6 +42,8 @@ void usage(const char* error) {
                "  --errors FILE writes the per-frame error delta_i (Sec. 4.1, metres), one a line.\n"
                "  --debug-dir DIR writes the tracking overlay (contour, keypoints, axes, status) of every\n"
                "  N-th frame (default 1) as DIR/<frame>.png.\n"
+               "  --trace FILE writes one CSV line per frame: status, state, quality, KLT tracked / inliers,\n"
+               "  energy before / after / level, colour contrast / level, searched (why a track was lost or kept).\n"
                "  DIR holds images (sorted by name), K.txt and pose.txt (first line = initial pose;\n"
                "  the rest, when present, is the ground truth used for scoring; with the initial pose alone\n"
                "  the run is not scored and --errors fails).\n"
@@ -52,7 +54,7 @@ void usage(const char* error) {
 }
 
 struct Options {
-  std::string sequence, model, preset = "realtime", output, summary_json, errors, debug_dir;
+  std::string sequence, model, preset = "realtime", output, summary_json, errors, debug_dir, trace;
   int debug_every = 1;
   double model_scale = 1.0;
   int max_frames = -1;
@@ -79,6 +81,7 @@ Options parse(int argc, char** argv) {
          kct_tools::flag("--quiet", o.quiet),
          {"--debug-dir", store(o.debug_dir)},
          {"--debug-every", store(o.debug_every)},
+         {"--trace", store(o.trace)},
          {"--param", [&o](const std::string& kv) {
             const auto eq = kv.find('=');
             if (eq == std::string::npos) throw std::invalid_argument("takes NAME=VALUE");
@@ -157,6 +160,13 @@ int main(int argc, char** argv) {
         {"energy", &kct::StageTimes::energy_ms},
         {"optimizer", &kct::StageTimes::optimizer_ms}};
     std::vector<std::vector<double>> stage_ms(stages.size());
+    std::ofstream trace;
+    if (!options.trace.empty()) {
+      trace.open(options.trace);
+      if (!trace) throw std::runtime_error(options.trace + ": cannot write");
+      trace << "frame,status,state,quality,good,klt_tracked,klt_inliers,energy_before,energy_after,"
+               "energy_level,color_contrast,color_level,searched\n";
+    }
     run_options.on_frame = [&](size_t i, const cv::Mat& image, const kct::SessionResult& result,
                                const kct::TrackingSession& session) {
       if (i > 0 && result.frame.status != kct::TrackStatus::kInvalidInput)
@@ -173,6 +183,16 @@ int main(int argc, char** argv) {
                                                          *mesh, session.tracker().diameter_m(),
                                                          session.tracker().contour_extractor(), label)))
           throw std::runtime_error(path + ": cannot write");
+      }
+      if (trace.is_open()) {
+        const kct::TrackResult& f = result.frame;
+        trace << i << ',' << kct::to_string(f.status) << ',' << kct::to_string(result.state) << ','
+              << cv::format("%.3f,%d,%d,%d,%.4g,%.4g,%.4g,%.3f,%.3f,%d", result.quality,
+                            result.good ? 1 : 0, f.keypoints.tracked, f.keypoints.inliers,
+                            f.energy_before, f.energy_after, session.monitor().energy_level(),
+                            result.color.valid ? result.color.contrast : -1.0,
+                            session.monitor().color_level(), result.searched ? 1 : 0)
+              << '\n';
       }
       if (!options.quiet) {
         std::cerr << "\r[" << (i + 1) << "/" << frames << "] " << std::setw(12)
