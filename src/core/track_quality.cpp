@@ -54,7 +54,7 @@ double TrackQualityMonitor::score(const TrackResult& result) const {
 }
 
 TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvidence& color,
-                                       double color_lost_ratio) {
+                                       const ColorLossRule& rule) {
   if (result.status == TrackStatus::kInvalidInput) return state_;
   if (result.status == TrackStatus::kNotInitialized) {
     reset();
@@ -71,8 +71,15 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
     const bool out_of_view = color.visible_fraction < kMinVisibleFraction;
     const bool faded = color.visible_fraction >= 0.3 && has_color_level_ &&
                        color_level_ >= kMinColorLevel &&
-                       color.contrast < color_lost_ratio * color_level_;
-    if (out_of_view || faded) {
+                       color.contrast < rule.lost_ratio * color_level_;
+    // The contour's veto (ours): measured on 48 hard sequences, a perfect track (2 mm error,
+    // 120 of 123 KLT inliers) lost its colour contrast to half the level under a shadow and was
+    // replaced by an own-colour distractor; its contour energy had stayed at the level.
+    const bool contour_holds = rule.contour_veto_ratio > 0.0 && result.refined &&
+                               has_energy_level_ && energy_level_ > 0.0 &&
+                               result.energy_after >= rule.contour_veto_ratio * energy_level_ &&
+                               color.contrast >= rule.vanished_ratio * color_level_;
+    if (out_of_view || (faded && !contour_holds)) {
       last_good_ = false;
       last_quality_ = std::min(last_quality_, params_.min_quality * 0.5);
     }

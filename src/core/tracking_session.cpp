@@ -176,7 +176,11 @@ SessionResult TrackingSession::track(const Frame& frame) {
     bgr = tracker_->undistorted_color(frame.image);
   result.frame = result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
   use_colors(bgr, result);
-  result.state = monitor_.update(result.frame, result.color, params_.color_lost_ratio);
+  ColorLossRule rule;
+  rule.lost_ratio = params_.color_lost_ratio;
+  rule.contour_veto_ratio = params_.color_contour_veto_ratio;
+  rule.vanished_ratio = params_.color_vanished_ratio;
+  result.state = monitor_.update(result.frame, result.color, rule);
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();

@@ -66,26 +66,71 @@ TEST(TrackQuality, ColourEvidenceMakesAFrameBadWhenTheOutlineStopsSeparatingTheC
   color.valid = true;
   color.contrast = 0.8;
   color.visible_fraction = 1.0;
-  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  monitor.update(refined_result(10.0, true, 1.0), color, ColorLossRule{0.4});
   EXPECT_TRUE(monitor.last_good());
   EXPECT_DOUBLE_EQ(monitor.color_level(), 0.8);
   // Energy and keypoints fine, contrast 0.3 < 0.4 x 0.8: bad, and the level stays.
   color.contrast = 0.3;
-  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  monitor.update(refined_result(10.0, true, 1.0), color, ColorLossRule{0.4});
   EXPECT_FALSE(monitor.last_good());
   EXPECT_DOUBLE_EQ(monitor.color_level(), 0.8);
   // 0.33 > 0.32: good again.
   color.contrast = 0.33;
-  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  monitor.update(refined_result(10.0, true, 1.0), color, ColorLossRule{0.4});
   EXPECT_TRUE(monitor.last_good());
   // Less than 10 % of the object in the image: bad whatever the other cues say.
   color.contrast = 0.8;
   color.visible_fraction = 0.05;
-  monitor.update(refined_result(10.0, true, 1.0), color, 0.4);
+  monitor.update(refined_result(10.0, true, 1.0), color, ColorLossRule{0.4});
   EXPECT_FALSE(monitor.last_good());
   // Without colour evidence (grey frames) nothing changes.
-  monitor.update(refined_result(10.0, true, 1.0), ColorEvidence{}, 0.4);
+  monitor.update(refined_result(10.0, true, 1.0), ColorEvidence{}, ColorLossRule{0.4});
   EXPECT_TRUE(monitor.last_good());
+}
+
+TEST(TrackQuality, TheContourVetoesAFadedColourVerdictUnlessTheColoursVanished) {
+  TrackQualityParams params;
+  params.energy_level_smoothing = 1.0;  // levels = the last good frame's
+  ColorLossRule rule;
+  rule.lost_ratio = 0.6;
+  rule.contour_veto_ratio = 0.85;
+  rule.vanished_ratio = 0.15;
+  ColorEvidence color;
+  color.valid = true;
+  color.visible_fraction = 1.0;
+  for (const double veto : {0.0, 0.85}) {
+    rule.contour_veto_ratio = veto;
+    TrackQualityMonitor monitor(params);
+    monitor.on_initialized(Pose::Identity());
+    color.contrast = 0.8;
+    monitor.update(refined_result(10.0, true, 1.0), color, rule);  // levels: energy 10, colour 0.8
+    ASSERT_TRUE(monitor.last_good());
+    // Contrast 0.3 < 0.6 x 0.8 (faded), energy 9 >= 0.85 x 10: the contour holds when the veto is on.
+    color.contrast = 0.3;
+    monitor.update(refined_result(9.0, true, 1.0), color, rule);
+    EXPECT_EQ(monitor.last_good(), veto > 0.0) << "veto " << veto;
+    // A vetoed frame is a good frame: both levels follow it (the colours changed, not the pose).
+    EXPECT_DOUBLE_EQ(monitor.energy_level(), veto > 0.0 ? 9.0 : 10.0);
+    EXPECT_DOUBLE_EQ(monitor.color_level(), veto > 0.0 ? 0.3 : 0.8);
+    // Contrast 0.1 (faded either way), energy 7 < 0.85 x 9 (or x 10): the colour verdict stands.
+    color.contrast = 0.1;
+    monitor.update(refined_result(7.0, true, 1.0), color, rule);
+    EXPECT_FALSE(monitor.last_good()) << "veto " << veto;
+  }
+  // Energy at the level but the contrast 0.1 < 0.15 x 0.8: the colours vanished, bad.
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  color.contrast = 0.8;
+  monitor.update(refined_result(10.0, true, 1.0), color, rule);
+  color.contrast = 0.1;
+  monitor.update(refined_result(10.0, true, 1.0), color, rule);
+  EXPECT_FALSE(monitor.last_good());
+  // Without refinement there is no contour to veto with.
+  TrackResult klt = refined_result(10.0, true, 1.0);
+  klt.refined = false;
+  color.contrast = 0.3;
+  monitor.update(klt, color, rule);
+  EXPECT_FALSE(monitor.last_good());
 }
 
 TEST(TrackQuality, AWeakColourModelIsNotEvidence) {
@@ -96,11 +141,11 @@ TEST(TrackQuality, AWeakColourModelIsNotEvidence) {
   ColorEvidence color;
   color.valid = true;
   color.contrast = 0.15;  // below kMinColorLevel at a good pose: the colours barely differ
-  monitor.update(refined_result(10.0, true, 1.0), color, 0.6);
+  monitor.update(refined_result(10.0, true, 1.0), color, ColorLossRule{0.6});
   ASSERT_TRUE(monitor.last_good());
   ASSERT_LT(monitor.color_level(), TrackQualityMonitor::kMinColorLevel);
   color.contrast = 0.0;  // would be "faded" with a useful model
-  monitor.update(refined_result(10.0, true, 1.0), color, 0.6);
+  monitor.update(refined_result(10.0, true, 1.0), color, ColorLossRule{0.6});
   EXPECT_TRUE(monitor.last_good());
 }
 

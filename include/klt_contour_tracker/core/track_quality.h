@@ -29,6 +29,20 @@ struct ColorEvidence {
   double visible_fraction = 1.0;  ///< share of the silhouette inside the image
 };
 
+/// When colour evidence makes a frame bad (TrackingSession fills it from TrackerParams'
+/// color_lost_ratio, color_contour_veto_ratio and color_vanished_ratio).
+struct ColorLossRule {
+  /// A frame is faded (bad) when its contrast is below this x the running level (0 = never).
+  double lost_ratio = 0.0;
+  /// 0 = off. A faded frame stays good while its refined contour energy is at least this x the
+  /// running energy level (the outline still lies on the object's edges: light, a shadow or a
+  /// newly seen side changed the colours, not the pose) ...
+  double contour_veto_ratio = 0.0;
+  /// ... unless its contrast is below this x the colour level (the outline's inside has lost
+  /// the object's colours: it lies on the background).
+  double vanished_ratio = 0.0;
+};
+
 /// Thresholds of the quality score and the state machine (all ours).
 struct TrackQualityParams {
   /// Weight of the energy cue in the score when the refinement ran; the KLT inlier ratio gets
@@ -67,10 +81,10 @@ class TrackQualityMonitor {
 
   /// Scores `result`, updates the energy level (good frames only), the last good pose and the
   /// state. Returns the new state. With valid `color` evidence a frame is also bad when less
-  /// than 10 % of the object is in the image or its contrast is below `color_lost_ratio` x the
-  /// running contrast level of good frames.
+  /// than 10 % of the object is in the image or its contrast is below `rule.lost_ratio` x the
+  /// running contrast level of good frames (`rule`: when the contour energy overrules that).
   TrackState update(const TrackResult& result, const ColorEvidence& color = {},
-                    double color_lost_ratio = 0.0);
+                    const ColorLossRule& rule = {});
   /// Running colour contrast of good frames (0 when none yet).
   double color_level() const { return color_level_; }
   /// Colour evidence counts only once the running contrast is at least this: a model whose

@@ -87,6 +87,11 @@ struct TrackerParams {
   bool color_search = false;
   int color_learn_interval_frames = 3;  ///< frames between two colour learnings
   double color_lost_ratio = 0.4;        ///< bad frame below this share of the contrast level
+  /// ours (0 = off): a frame below color_lost_ratio stays good while its refined contour energy
+  /// is at least this share of its running level, unless its contrast is below
+  /// color_vanished_ratio x the colour level (track_quality.h, ColorLossRule).
+  double color_contour_veto_ratio = 0.0;
+  double color_vanished_ratio = 0.15;   ///< see color_contour_veto_ratio
   double color_accept_ratio = 0.6;      ///< re-acquire from a placement above this share
   /// Re-acquisition refines the best color_search_placements colour placements, each also
   /// turned by +-color_search_rotation_deg about the camera axes (0: not turned), and the last
