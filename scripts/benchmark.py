@@ -48,8 +48,9 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_shift_search", "realtime", {"shift_search_diameters": "0"}),
     # re-acquisition takes only placements above color_accept_ratio (no two-frame confirmation)
     ("realtime_no_confirm", "realtime", {"color_confirm_ratio": "0"}),
-    # the colour verdict of a loss taken even while the contour energy stays at its level
-    ("realtime_no_contour_veto", "realtime", {"color_contour_veto_ratio": "0"}),
+    # the colour verdict of a loss taken even while the contour energy or KLT says the pose holds
+    ("realtime_no_color_veto", "realtime",
+     {"color_contour_veto_ratio": "0", "color_keypoint_veto_inliers": "0"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     ("realtime_motion_model", "realtime",

@@ -77,9 +77,13 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
     // replaced by an own-colour distractor; its contour energy had stayed at the level.
     const bool contour_holds = rule.contour_veto_ratio > 0.0 && result.refined &&
                                has_energy_level_ && energy_level_ > 0.0 &&
-                               result.energy_after >= rule.contour_veto_ratio * energy_level_ &&
-                               color.contrast >= rule.vanished_ratio * color_level_;
-    if (out_of_view || (faded && !contour_holds)) {
+                               result.energy_after >= rule.contour_veto_ratio * energy_level_;
+    const bool keypoints_hold = rule.keypoint_veto_inliers > 0 && result.keypoints.success &&
+                                result.keypoints.inliers >= rule.keypoint_veto_inliers &&
+                                result.keypoints.inlier_ratio >= rule.keypoint_veto_inlier_ratio;
+    const bool vetoed = (contour_holds || keypoints_hold) &&
+                        color.contrast >= rule.vanished_ratio * color_level_;
+    if (out_of_view || (faded && !vetoed)) {
       last_good_ = false;
       last_quality_ = std::min(last_quality_, params_.min_quality * 0.5);
     }

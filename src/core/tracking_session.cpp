@@ -179,6 +179,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   ColorLossRule rule;
   rule.lost_ratio = params_.color_lost_ratio;
   rule.contour_veto_ratio = params_.color_contour_veto_ratio;
+  rule.keypoint_veto_inliers = params_.color_keypoint_veto_inliers;
   rule.vanished_ratio = params_.color_vanished_ratio;
   result.state = monitor_.update(result.frame, result.color, rule);
   if (result.has_pose()) {

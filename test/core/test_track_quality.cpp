@@ -128,9 +128,32 @@ TEST(TrackQuality, TheContourVetoesAFadedColourVerdictUnlessTheColoursVanished) 
   // Without refinement there is no contour to veto with.
   TrackResult klt = refined_result(10.0, true, 1.0);
   klt.refined = false;
+  klt.keypoints.inliers = 150;
   color.contrast = 0.3;
   monitor.update(klt, color, rule);
   EXPECT_FALSE(monitor.last_good());
+  // ... but 150 KLT inliers at a ratio of 0.97 veto it when keypoint_veto_inliers <= 150, not
+  // at a ratio of 0.9, and not once the colours vanished.
+  rule.keypoint_veto_inliers = 100;
+  klt.keypoints.inlier_ratio = 0.97;
+  monitor.update(klt, color, rule);
+  EXPECT_TRUE(monitor.last_good());
+  TrackQualityMonitor fresh(params);
+  fresh.on_initialized(Pose::Identity());
+  color.contrast = 0.8;
+  fresh.update(refined_result(10.0, true, 1.0), color, rule);
+  color.contrast = 0.3;
+  klt.keypoints.inlier_ratio = 0.9;
+  fresh.update(klt, color, rule);
+  EXPECT_FALSE(fresh.last_good());
+  klt.keypoints.inlier_ratio = 0.97;
+  color.contrast = 0.1;
+  fresh.update(klt, color, rule);
+  EXPECT_FALSE(fresh.last_good());
+  color.contrast = 0.3;
+  klt.keypoints.inliers = 99;
+  fresh.update(klt, color, rule);
+  EXPECT_FALSE(fresh.last_good());
 }
 
 TEST(TrackQuality, AWeakColourModelIsNotEvidence) {

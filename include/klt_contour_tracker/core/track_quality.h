@@ -38,8 +38,14 @@ struct ColorLossRule {
   /// running energy level (the outline still lies on the object's edges: light, a shadow or a
   /// newly seen side changed the colours, not the pose) ...
   double contour_veto_ratio = 0.0;
-  /// ... unless its contrast is below this x the colour level (the outline's inside has lost
-  /// the object's colours: it lies on the background).
+  /// 0 = off. A faded frame also stays good when KLT kept at least this many RANSAC inliers at
+  /// an inlier ratio >= keypoint_veto_inlier_ratio (a flash or a moving light changes the
+  /// colours and the edges at once, while the keypoints, matched on locally normalized
+  /// frames, still agree), ...
+  int keypoint_veto_inliers = 0;
+  double keypoint_veto_inlier_ratio = 0.95;  ///< see keypoint_veto_inliers
+  /// ... unless (either veto) its contrast is below this x the colour level (the outline's
+  /// inside has lost the object's colours: it lies on the background).
   double vanished_ratio = 0.0;
 };
 

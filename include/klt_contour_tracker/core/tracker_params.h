@@ -91,6 +91,9 @@ struct TrackerParams {
   /// is at least this share of its running level, unless its contrast is below
   /// color_vanished_ratio x the colour level (track_quality.h, ColorLossRule).
   double color_contour_veto_ratio = 0.0;
+  /// ours (0 = off): ... or while KLT keeps at least this many RANSAC inliers at an inlier
+  /// ratio >= 0.95 (same exception).
+  int color_keypoint_veto_inliers = 0;
   double color_vanished_ratio = 0.15;   ///< see color_contour_veto_ratio
   double color_accept_ratio = 0.6;      ///< re-acquire from a placement above this share
   /// Re-acquisition refines the best color_search_placements colour placements, each also
