@@ -51,6 +51,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     # the colour verdict of a loss taken even while the contour energy or KLT says the pose holds
     ("realtime_no_color_veto", "realtime",
      {"color_contour_veto_ratio": "0", "color_keypoint_veto_inliers": "0"}),
+    # keypoints anchored after a KLT failure kept even when the frame is judged bad
+    ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     ("realtime_motion_model", "realtime",

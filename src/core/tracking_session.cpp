@@ -182,6 +182,9 @@ SessionResult TrackingSession::track(const Frame& frame) {
   rule.keypoint_veto_inliers = params_.color_keypoint_veto_inliers;
   rule.vanished_ratio = params_.color_vanished_ratio;
   result.state = monitor_.update(result.frame, result.color, rule);
+  if (params_.drop_unconfirmed_anchors && result.frame.status == TrackStatus::kExtrapolated &&
+      !monitor_.last_good())
+    tracker_->forget_keypoints();
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();

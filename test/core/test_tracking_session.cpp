@@ -35,6 +35,32 @@ struct Scene {
   }
 };
 
+/// drop_unconfirmed_anchors: the object vanishes; the first hidden frame's KLT fails, the
+/// refinement ends on background and keypoints are anchored there. Kept, the next frame's KLT
+/// follows them (the background does not move); dropped, the next frame has none to follow.
+TEST(TrackingSession, AnchorsLaidOnABadFrameAreDroppedWhenAsked) {
+  const Scene scene;
+  for (const bool drop : {false, true}) {
+    TrackerParams params = quick_paper();
+    params.drop_unconfirmed_anchors = drop;
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.initialize(scene.pose(0));
+    double stamp = 1.0;
+    for (int frame = 0; frame < 6; ++frame, stamp += 0.033)
+      ASSERT_TRUE(session.track({scene.visible(frame), stamp}).good) << frame;
+    const SessionResult first = session.track({scene.hidden(6), stamp += 0.033});
+    ASSERT_EQ(first.frame.status, TrackStatus::kExtrapolated) << "KLT fails when the object vanishes";
+    ASSERT_FALSE(first.good);
+    const SessionResult next = session.track({scene.hidden(7), stamp += 0.033});
+    ASSERT_EQ(next.state, TrackState::kTracking) << "not lost yet: the tracker ran";
+    if (drop)
+      EXPECT_EQ(next.frame.keypoints.tracked, 0) << "the anchors of the bad frame were dropped";
+    else
+      EXPECT_GT(next.frame.keypoints.tracked, 8) << "the anchors on the background were followed";
+  }
+}
+
 TEST(TrackingSession, LosesTheHiddenObjectAndReacquiresItWhenItComesBack) {
   const Scene scene;
   TrackingSession session(scene.mesh, quick_paper());

@@ -74,6 +74,10 @@ class Tracker {
   void initialize(const Pose& object_to_camera);
   /// Drops the track; track() returns kNotInitialized until initialize() is called again.
   void reset();
+  /// Drops the keypoints anchored so far; the next frame's KLT fails and its pose comes from
+  /// the extrapolation and the refinement, which anchor new ones (the tracking session calls it
+  /// when it judges a frame whose keypoints were anchored on an unverified pose to be bad).
+  void forget_keypoints() { keypoints_.clear(); }
   bool is_initialized() const { return state_ != State::kWaiting; }
 
   /// Runs the pipeline on one frame.

@@ -108,6 +108,12 @@ struct TrackerParams {
   /// level of 0.63 on the chest behind the occluder), while a wrong placement rarely wins twice
   /// at the same place.
   double color_confirm_ratio = 0.0;
+  /// ours (tracking session): keypoints anchored on a frame where KLT failed (at the
+  /// extrapolated + refined pose) are dropped again when the session's quality monitor judges
+  /// that frame bad, so that KLT never follows anchors laid on a wrong pose (they track the
+  /// background or a spun copy of the object consistently, and look healthy); the next frame is
+  /// refined from the contour again and anchors afresh.
+  bool drop_unconfirmed_anchors = false;
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline
