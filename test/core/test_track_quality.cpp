@@ -88,7 +88,21 @@ TEST(TrackQuality, ColourEvidenceMakesAFrameBadWhenTheOutlineStopsSeparatingTheC
   EXPECT_TRUE(monitor.last_good());
 }
 
-TEST(TrackQuality, TheContourVetoesAFadedColourVerdictUnlessTheColoursVanished) {
+/// A monitor after one good refined frame with energy 10 and colour contrast 0.8 (its levels, with
+/// energy_level_smoothing 1).
+TrackQualityMonitor monitor_at_levels(const TrackQualityParams& params, const ColorLossRule& rule) {
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  ColorEvidence color;
+  color.valid = true;
+  color.contrast = 0.8;
+  color.visible_fraction = 1.0;
+  monitor.update(refined_result(10.0, true, 1.0), color, rule);
+  EXPECT_TRUE(monitor.last_good());
+  return monitor;
+}
+
+TEST(TrackQuality, TheContourOrKltVetoAFadedColourVerdictUnlessTheColoursVanished) {
   TrackQualityParams params;
   params.energy_level_smoothing = 1.0;  // levels = the last good frame's
   ColorLossRule rule;
@@ -100,11 +114,7 @@ TEST(TrackQuality, TheContourVetoesAFadedColourVerdictUnlessTheColoursVanished) 
   color.visible_fraction = 1.0;
   for (const double veto : {0.0, 0.85}) {
     rule.contour_veto_ratio = veto;
-    TrackQualityMonitor monitor(params);
-    monitor.on_initialized(Pose::Identity());
-    color.contrast = 0.8;
-    monitor.update(refined_result(10.0, true, 1.0), color, rule);  // levels: energy 10, colour 0.8
-    ASSERT_TRUE(monitor.last_good());
+    TrackQualityMonitor monitor = monitor_at_levels(params, rule);  // energy 10, colour 0.8
     // Contrast 0.3 < 0.6 x 0.8 (faded), energy 9 >= 0.85 x 10: the contour holds when the veto is on.
     color.contrast = 0.3;
     monitor.update(refined_result(9.0, true, 1.0), color, rule);
@@ -118,10 +128,7 @@ TEST(TrackQuality, TheContourVetoesAFadedColourVerdictUnlessTheColoursVanished) 
     EXPECT_FALSE(monitor.last_good()) << "veto " << veto;
   }
   // Energy at the level but the contrast 0.1 < 0.15 x 0.8: the colours vanished, bad.
-  TrackQualityMonitor monitor(params);
-  monitor.on_initialized(Pose::Identity());
-  color.contrast = 0.8;
-  monitor.update(refined_result(10.0, true, 1.0), color, rule);
+  TrackQualityMonitor monitor = monitor_at_levels(params, rule);
   color.contrast = 0.1;
   monitor.update(refined_result(10.0, true, 1.0), color, rule);
   EXPECT_FALSE(monitor.last_good());
@@ -138,10 +145,7 @@ TEST(TrackQuality, TheContourVetoesAFadedColourVerdictUnlessTheColoursVanished) 
   klt.keypoints.inlier_ratio = 0.97;
   monitor.update(klt, color, rule);
   EXPECT_TRUE(monitor.last_good());
-  TrackQualityMonitor fresh(params);
-  fresh.on_initialized(Pose::Identity());
-  color.contrast = 0.8;
-  fresh.update(refined_result(10.0, true, 1.0), color, rule);
+  TrackQualityMonitor fresh = monitor_at_levels(params, rule);
   color.contrast = 0.3;
   klt.keypoints.inlier_ratio = 0.9;
   fresh.update(klt, color, rule);

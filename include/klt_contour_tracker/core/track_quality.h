@@ -30,7 +30,8 @@ struct ColorEvidence {
 };
 
 /// When colour evidence makes a frame bad (TrackingSession fills it from TrackerParams'
-/// color_lost_ratio, color_contour_veto_ratio and color_vanished_ratio).
+/// color_lost_ratio, color_contour_veto_ratio, color_keypoint_veto_inliers and
+/// color_vanished_ratio).
 struct ColorLossRule {
   /// A frame is faded (bad) when its contrast is below this x the running level (0 = never).
   double lost_ratio = 0.0;
@@ -88,7 +89,7 @@ class TrackQualityMonitor {
   /// Scores `result`, updates the energy level (good frames only), the last good pose and the
   /// state. Returns the new state. With valid `color` evidence a frame is also bad when less
   /// than 10 % of the object is in the image or its contrast is below `rule.lost_ratio` x the
-  /// running contrast level of good frames (`rule`: when the contour energy overrules that).
+  /// running contrast level of good frames (`rule`: when the contour energy or KLT overrules that).
   TrackState update(const TrackResult& result, const ColorEvidence& color = {},
                     const ColorLossRule& rule = {});
   /// Running colour contrast of good frames (0 when none yet).
