@@ -1,6 +1,7 @@
 #include "klt_contour_tracker/core/keypoint_tracker.h"
 
 #include "klt_contour_tracker/core/search_area.h"
+#include "klt_contour_tracker/core/surface_anchor.h"
 
 #include <algorithm>
 #include <chrono>
@@ -126,29 +127,15 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
                           params_.corner_quality_level, params_.corner_min_distance_px * s,
                           mask(crop));
 
-  // Anchor each corner on the mesh: intersect its camera ray with the plane of the face the
-  // face-index buffer shows there (exact on the triangle, unlike the rasterized depth).
-  const Pose camera_to_object = object_to_camera.inverse();
-  const Mesh& mesh = *mesh_;
+  // Anchor each corner on the mesh (surface_anchor.h).
   for (const cv::Point2f& corner_in_crop : corners) {
     const cv::Point2f corner_small = corner_in_crop + cv::Point2f(crop.x, crop.y);
     // cv::pyrDown keeps pixel centres at integer coordinates: full = small / s.
     const cv::Point2f corner = corner_small * static_cast<float>(1.0 / s);
-    const int u = static_cast<int>(std::lround(corner_small.x));
-    const int v = static_cast<int>(std::lround(corner_small.y));
-    if (u < 0 || v < 0 || u >= render.face_index.cols || v >= render.face_index.rows) continue;
-    const int face = render.face_index.at<int>(v, u);
-    if (face < 0) continue;
-    const Eigen::Vector3i& f = mesh.faces[face];
-    const Eigen::Vector3d p0 = object_to_camera * mesh.vertices[f[0]];
-    const Eigen::Vector3d normal =
-        object_to_camera.linear() * mesh.face_normal(face);
-    const Eigen::Vector3d ray = camera.back_project({corner.x, corner.y});
-    const double denominator = normal.dot(ray);
-    if (std::abs(denominator) < 1e-9) continue;  // ray grazes the face
-    const double depth = normal.dot(p0) / denominator;
-    if (!(depth > 0) || !std::isfinite(depth)) continue;
-    const Eigen::Vector3d point_object = camera_to_object * (depth * ray);
+    Eigen::Vector3d point_object;
+    if (!anchor_on_surface(render.face_index, corner_small, corner, *mesh_, object_to_camera,
+                           camera, &point_object))
+      continue;
     image_points_.push_back(corner);
     object_points_.emplace_back(static_cast<float>(point_object.x()),
                                 static_cast<float>(point_object.y()),
