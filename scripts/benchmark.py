@@ -55,6 +55,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
+    # ORB keyframes: tracking by detection for textured objects (feature_relocalizer.h)
+    ("realtime_feature_relocalization", "realtime", {"feature_relocalization": "true"}),
     ("realtime_motion_model", "realtime",
      {"motion_model": "true", "motion_prior_weight": "1", "keypoint_motion_gate_sigmas": "3"}),
 ]
@@ -652,6 +654,47 @@ def opt_sequence(data, obj, group, speed):
     return cached_run(cmd, folder, "rendering %s/%s" % (obj, seq_name(group, speed)))
 
 
+def startup_ms(folder, model, preset, cache_dir):
+    """Session start-up (tracker + visibility table) of track_sequence on one frame, ms."""
+    out = os.path.join(cache_dir, "startup.json")
+    cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder, "--model", model,
+           "--preset", preset, "--param", "visibility_cache_dir=" + cache_dir, "--max-frames", "1",
+           "--summary-json", out, "--quiet"]
+    if subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
+        return None
+    with open(out) as f:
+        return json.load(f).get("startup_ms")
+
+
+def startup_table(configs, objects, folders, sequences, data, tmp):
+    """First start (the visibility table built) and a cached start, per object and preset."""
+    presets = [c[1] for c in configs if c[1] == c[0]]  # plain presets (ablations share them)
+    L = ["### Start-up (visibility table)\n",
+         "Wall time of the session's start before the first frame (tracker, visibility table), ms: "
+         "`first` with an empty cache (the table is built), `cached` the second start on the same "
+         "model (read from `visibility_cache_dir`). One run each, measured after the tracking "
+         "runs above. `klt_only` has no visibility table.\n"]
+    L.append("| object | faces | " + " | ".join("%s first | %s cached" % (p, p) for p in presets) + " |")
+    L.append("|---|---|" + "---|---|" * len(presets))
+    for o in objects:
+        model = os.path.join(data, "models", OBJECTS[o]["model"] + ".obj")
+        folder = folders[(o,) + tuple(sequences[0])]
+        cells = []
+        faces = "-"
+        for p in presets:
+            cache = os.path.join(tmp, "startup_cache_%s_%s" % (o, p))
+            subprocess.run(["rm", "-rf", cache])
+            os.makedirs(cache)
+            first = startup_ms(folder, model, p, cache)
+            cached = startup_ms(folder, model, p, cache)
+            cells += [fmt(first, 0), fmt(cached, 0)]
+        with open(model) as f:
+            faces = str(sum(1 for line in f if line.startswith("f ")))
+        L.append("| %s | %s | %s |" % (o, faces, " | ".join(cells)))
+    L.append("")
+    return L
+
+
 def run_opt(args, configs, runner, data, docs_dir, tmp):
     global QUICK_FRAMES
     if args.frames:
@@ -781,6 +824,7 @@ def run_opt(args, configs, runner, data, docs_dir, tmp):
     L.append("Growth from the smallest to the largest mesh at 640x480 (the paper: 2.4x): " + ", ".join(
         "%s %s" % (p, growth(p)) for p in presets) + ".\n")
     L += stage_table(rows, configs, [(o, sel(object=o)) for o in objects])
+    L += startup_table(configs, objects, folders, sequences, data, tmp)
     L.append("### Other metrics\n")
     L.append("| preset | object | success 5 cm / 5 deg | mean ADD, mm | extrapolated frames |")
     L.append("|---|---|---|---|---|")

@@ -38,6 +38,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(color_accept_ratio),
       KCT_FIELD(color_search_placements), KCT_FIELD(color_search_rotation_deg),
       KCT_FIELD(color_confirm_ratio), KCT_FIELD(drop_unconfirmed_anchors),
+      KCT_FIELD(feature_relocalization), KCT_FIELD(relocalization_override_inliers),
       KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
       KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
       KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
@@ -167,6 +168,7 @@ void TrackerParams::validate() const {
                                 "' is not one of basin_hopping, coarse_to_fine");
   check_range(kOwner, "pyramid_levels", pyramid_levels, 1, 6);
   check_range(kOwner, "iterations_per_level", iterations_per_level, 1, 1000);
+  check_range(kOwner, "relocalization_override_inliers", relocalization_override_inliers, 6, 100000);
   check_range(kOwner, "contour_weight", contour_weight, 0.0, 1e6);
   check_range(kOwner, "keypoint_weight", keypoint_weight, 0.0, 1e6);
   check_range(kOwner, "keypoint_sigma_px", keypoint_sigma_px, 0.01, 1000.0);

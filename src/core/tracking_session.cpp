@@ -4,6 +4,21 @@
 #include <stdexcept>
 
 namespace kct {
+namespace {
+
+/// feature_relocalization: a keyframe is added on a good frame with at least this quality and
+/// KLT inlier ratio, from a new viewpoint, whose pose the existing keyframes confirmed.
+constexpr double kKeyframeMinQuality = 0.8;
+constexpr double kKeyframeMinInlierRatio = 0.8;
+/// feature_relocalization: features are matched within this share of the object's projected
+/// size around the held pose.
+constexpr double kRegionMargin = 0.5;
+/// feature_relocalization: the relocalized pose agrees with the held one when their centres are
+/// less than this many diameters apart and their rotations less than this many degrees.
+constexpr double kAgreementDiameters = 0.05;
+constexpr double kAgreementDeg = 5.0;
+
+}  // namespace
 
 bool SessionResult::has_pose() const {
   return frame.status != TrackStatus::kNotInitialized && frame.status != TrackStatus::kInvalidInput;
@@ -24,6 +39,8 @@ void TrackingSession::set_camera(const PinholeCamera& camera) {
   else
     tracker_->set_camera(camera);
   if (params_.color_search && !search_) search_ = std::make_unique<ObjectSearch>(mesh_);
+  if (params_.feature_relocalization && !relocalizer_)
+    relocalizer_ = std::make_unique<FeatureRelocalizer>(mesh_);
 }
 
 const Tracker& TrackingSession::tracker() const {
@@ -36,6 +53,7 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   tracker_->initialize(object_to_camera);  // validates the pose
   monitor_.on_initialized(object_to_camera);
   if (search_) search_->clear();  // a new track may be another scene
+  if (relocalizer_) relocalizer_->clear();
   frames_since_learning_ = 0;
   initialized_since_last_frame_ = true;
   lost_at_frame_ = -1;
@@ -54,6 +72,10 @@ void TrackingSession::set_params(const TrackerParams& params) {
   params.validate();
   if (tracker_) tracker_->set_params(params);
   params_ = params;
+  if (!params_.feature_relocalization)
+    relocalizer_.reset();
+  else if (!relocalizer_ && tracker_)
+    relocalizer_ = std::make_unique<FeatureRelocalizer>(mesh_);
   if (!params_.color_search)
     search_.reset();
   else if (!search_ && tracker_)
@@ -130,6 +152,61 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 
+bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
+  if (relocalizer_->keyframes() == 0) return false;
+  const Relocalization found = relocalizer_->locate(gray, tracker_->camera());
+  if (!found.found) return false;
+  TrackResult located;
+  located.status = TrackStatus::kReacquired;
+  located.object_to_camera = located.preliminary_object_to_camera = found.object_to_camera;
+  tracker_->adopt(frame, located);
+  result.frame = located;
+  result.relocalized = true;
+  return true;
+}
+
+void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
+  const TrackStatus status = result.frame.status;
+  if (relocalizer_->keyframes() == 0 ||
+      (status != TrackStatus::kKeypoints && status != TrackStatus::kExtrapolated &&
+       status != TrackStatus::kReacquired))
+    return;
+  const Pose& held = result.frame.object_to_camera;
+  const PinholeCamera& camera = tracker_->camera();
+  const Relocalization found =
+      relocalizer_->locate(gray, camera, relocalizer_->region_around(held, camera, kRegionMargin));
+  if (!found.found) return;
+  const Eigen::Vector3d center = mesh_->bounding_box_center();
+  const double moved_m = ((found.object_to_camera * center) - (held * center)).norm();
+  if (moved_m < kAgreementDiameters * tracker_->diameter_m() &&
+      rotation_error_deg(found.object_to_camera, held) < kAgreementDeg) {
+    features_confirm_ = true;
+    return;
+  }
+  // A pose from many features that disagrees with the held one replaces it: the track is the
+  // one anchored on something else (KLT anchors laid at a wrong pose hold it there).
+  if (found.inliers < params_.relocalization_override_inliers) return;
+  TrackResult located;
+  located.status = TrackStatus::kReacquired;
+  located.object_to_camera = located.preliminary_object_to_camera = found.object_to_camera;
+  located.frame_time_ms = result.frame.frame_time_ms;
+  tracker_->adopt(frame, located);
+  result.frame = located;
+  result.relocalized = true;
+}
+
+void TrackingSession::add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result) {
+  if (!result.has_pose()) return;
+  const TrackResult& f = result.frame;
+  const bool given = f.status == TrackStatus::kInitialized;
+  const bool confident = f.status == TrackStatus::kKeypoints && monitor_.last_good() &&
+                         result.state == TrackState::kTracking && features_confirm_ &&
+                         monitor_.last_quality() >= kKeyframeMinQuality &&
+                         f.keypoints.inlier_ratio >= kKeyframeMinInlierRatio;
+  if ((given || confident) && relocalizer_->wants_keyframe(f.object_to_camera))
+    relocalizer_->add_keyframe(gray, f.object_to_camera, tracker_->camera());
+}
+
 void TrackingSession::use_colors(const cv::Mat& bgr, SessionResult& result) {
   if (!search_ || bgr.empty() || !result.has_pose()) return;
   const Pose& pose = result.frame.object_to_camera;
@@ -174,7 +251,16 @@ SessionResult TrackingSession::track(const Frame& frame) {
   if (search_ && frame.image.type() == CV_8UC3 && frame.image.size() == tracker_->camera().size() &&
       !ObjectSearch::looks_grey(frame.image))
     bgr = tracker_->undistorted_color(frame.image);
-  result.frame = result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
+  // The feature relocalizer's frame (undistorted grey), when it is on and the frame is usable.
+  cv::Mat gray;
+  if (relocalizer_ && tracker_->check_frame(frame).empty())
+    gray = tracker_->undistorted_gray(frame.image);
+  features_confirm_ = false;
+  if (!(result.reacquiring && !gray.empty() && relocalize(frame, gray, result))) {
+    result.frame =
+        result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
+    if (!gray.empty()) use_features(frame, gray, result);
+  }
   use_colors(bgr, result);
   ColorLossRule rule;
   rule.lost_ratio = params_.color_lost_ratio;
@@ -185,6 +271,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   if (params_.drop_unconfirmed_anchors && result.frame.status == TrackStatus::kExtrapolated &&
       !monitor_.last_good())
     tracker_->forget_keypoints();
+  if (!gray.empty()) add_keyframe_if_due(gray, result);
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();

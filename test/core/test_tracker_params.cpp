@@ -110,7 +110,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 70u);
+  EXPECT_EQ(fields.size(), 72u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -138,6 +138,12 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   bad = realtime;
   bad.color_learn_interval_frames = 0;
   EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.relocalization_override_inliers = 3;  // fewer than PnP + a check need
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  // The feature relocalizer is off in every preset (measured even on the hard sets).
+  EXPECT_FALSE(realtime.feature_relocalization);
+  EXPECT_FALSE(make_preset("paper").feature_relocalization);
   // The session's colour model and the PnP motion bounds are ours: off in paper and klt_only.
   EXPECT_TRUE(realtime.color_search);
   EXPECT_FALSE(make_preset("paper").color_search);

@@ -114,6 +114,10 @@ class Tracker {
   const ContourExtractor* contour_extractor() const;
   /// `image` in colour, undistorted as the pipeline sees it (CV_8UC3); empty for a grey image.
   cv::Mat undistorted_color(const cv::Mat& image) const { return to_bgr(image); }
+  /// `image` in grey, undistorted as the pipeline sees it (CV_8UC1).
+  cv::Mat undistorted_gray(const cv::Mat& image) const { return to_gray(image); }
+  /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
+  std::string check_frame(const Frame& frame) const;
   /// Mesh diameter, metres (computed once).
   double diameter_m() const { return diameter_m_; }
   /// Last pose output (valid when is_initialized()).
@@ -136,8 +140,6 @@ class Tracker {
   cv::Mat to_bgr(const cv::Mat& image) const;
   /// Pose expected in the next frame: the motion model's prediction, else the last pose.
   Pose predicted_pose() const;
-  /// kInvalidInput message for a frame track() cannot use, "" when the frame is fine.
-  std::string check_frame(const Frame& frame) const;
 
   std::shared_ptr<const Mesh> mesh_;
   PinholeCamera camera_;

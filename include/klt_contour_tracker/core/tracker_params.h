@@ -114,6 +114,14 @@ struct TrackerParams {
   /// background or a spun copy of the object consistently, and look healthy); the next frame is
   /// refined from the contour again and anchors afresh.
   bool drop_unconfirmed_anchors = false;
+  /// ours (tracking session, feature_relocalizer.h): ORB features of keyframes (the initial
+  /// pose, then good frames from new viewpoints) anchored on the mesh; each frame they are
+  /// matched around the tracked pose, and a PnP pose from at least
+  /// relocalization_override_inliers features that disagrees with the track replaces it; while
+  /// lost they are matched over the whole frame to re-acquire. Textured objects only (an
+  /// untextured one never gives enough features: the option then does nothing).
+  bool feature_relocalization = false;
+  int relocalization_override_inliers = 25;  ///< PnP inliers needed to replace a held track
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline

@@ -12,6 +12,7 @@
 
 #include "klt_contour_tracker/core/camera.h"
 #include "klt_contour_tracker/core/mesh.h"
+#include "klt_contour_tracker/core/feature_relocalizer.h"
 #include "klt_contour_tracker/core/object_search.h"
 #include "klt_contour_tracker/core/pose.h"
 #include "klt_contour_tracker/core/track_quality.h"
@@ -30,6 +31,9 @@ struct SessionResult {
   bool reacquiring = false;  ///< the frame ran re-acquisition instead of tracking
   /// Re-acquisition started from the colour search's best placement (color_search).
   bool searched = false;
+  /// The pose came from the feature relocalizer (feature_relocalization): a re-acquisition
+  /// while lost, or a held track it replaced.
+  bool relocalized = false;
   ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
   bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
   bool restarted = false;    ///< ... and the session restarted from restart_pose()
@@ -102,6 +106,14 @@ class TrackingSession {
  private:
   TrackResult reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched);
   void count(const SessionResult& result);
+  /// feature_relocalization, on a frame the pipeline tracked (`gray` undistorted): the
+  /// keyframes' features around the held pose confirm it, or replace it when they disagree.
+  void use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result);
+  /// feature_relocalization, while lost: the keyframes' features over the whole frame; true
+  /// when they re-acquired the object (`result` then holds it).
+  bool relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result);
+  /// Adds a keyframe on the initial frame and on confident frames seen from a new viewpoint.
+  void add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result);
   /// The colour model's evidence for `result` and its learning on good frames (color_search).
   void use_colors(const cv::Mat& bgr, SessionResult& result);
 
@@ -110,6 +122,11 @@ class TrackingSession {
   TrackQualityMonitor monitor_;
   std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<ObjectSearch> search_;  ///< the colour model; null unless color_search
+  /// Keyframe features; null unless feature_relocalization.
+  std::unique_ptr<FeatureRelocalizer> relocalizer_;
+  /// This frame's held pose was confirmed by the keyframes' features (a new keyframe is added
+  /// only on such a frame, so that a wrong track never becomes a keyframe).
+  bool features_confirm_ = false;
   int frames_since_learning_ = 0;
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
