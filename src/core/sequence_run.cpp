@@ -1,5 +1,7 @@
 #include "klt_contour_tracker/core/sequence_run.h"
 
+#include <chrono>
+
 #include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -47,8 +49,11 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
   const cv::Size size = read_image_size(first_path);
   run.camera = PinholeCamera::from_matrix(sequence.K, size.width, size.height);
 
+  const auto startup = std::chrono::steady_clock::now();
   TrackingSession session(std::move(mesh), params, options.quality);
   session.set_camera(run.camera);
+  run.startup_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - startup).count();
   session.initialize(sequence.poses.front());
   Pose last = sequence.poses.front();
   for (std::size_t i = 0; i < frames; ++i) {

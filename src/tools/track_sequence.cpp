@@ -43,7 +43,8 @@ void usage(const char* error) {
                "  --debug-dir DIR writes the tracking overlay (contour, keypoints, axes, status) of every\n"
                "  N-th frame (default 1) as DIR/<frame>.png.\n"
                "  --trace FILE writes one CSV line per frame: status, state, quality, KLT tracked / inliers,\n"
-               "  energy before / after / level, colour contrast / level, searched (why a track was lost or kept).\n"
+               "  energy before / after / level, colour contrast / level, searched, colour visible fraction,\n"
+               "  relocalized (why a track was lost or kept).\n"
                "  DIR holds images (sorted by name), K.txt and pose.txt (first line = initial pose;\n"
                "  the rest, when present, is the ground truth used for scoring; with the initial pose alone\n"
                "  the run is not scored and --errors fails).\n"
@@ -165,7 +166,7 @@ int main(int argc, char** argv) {
       trace.open(options.trace);
       if (!trace) throw std::runtime_error(options.trace + ": cannot write");
       trace << "frame,status,state,quality,good,klt_tracked,klt_inliers,energy_before,energy_after,"
-               "energy_level,color_contrast,color_level,searched\n";
+               "energy_level,color_contrast,color_level,searched,color_visible,relocalized\n";
     }
     run_options.on_frame = [&](size_t i, const cv::Mat& image, const kct::SessionResult& result,
                                const kct::TrackingSession& session) {
@@ -192,6 +193,8 @@ int main(int argc, char** argv) {
                             f.energy_before, f.energy_after, session.monitor().energy_level(),
                             result.color.valid ? result.color.contrast : -1.0,
                             session.monitor().color_level(), result.searched ? 1 : 0)
+              << cv::format(",%.3f,%d", result.color.valid ? result.color.visible_fraction : -1.0,
+                            result.relocalized ? 1 : 0)
               << '\n';
       }
       if (!options.quiet) {
@@ -218,6 +221,7 @@ int main(int argc, char** argv) {
          << ",\n  \"frames_lost\": " << stats.frames_lost << ",\n  \"losses\": " << stats.losses
          << ",\n  \"reacquisitions\": " << stats.reacquisitions
          << ",\n  \"frames_to_reacquire\": [" << join(stats.frames_to_reacquire) << "]"
+         << ",\n  \"startup_ms\": " << run.startup_ms
          << ",\n  \"median_ms\": " << kct::median(run.frame_ms) << ",\n  \"stage_median_ms\": {";
     for (size_t k = 0; k < stages.size(); ++k)
       json << (k ? ", " : "") << "\"" << stages[k].first << "\": " << kct::median(stage_ms[k]);
@@ -229,6 +233,7 @@ int main(int argc, char** argv) {
     std::printf("losses            %d\n", stats.losses);
     std::printf("reacquisitions    %d  (frames from loss to re-acquired: %s)\n", stats.reacquisitions,
                 stats.frames_to_reacquire.empty() ? "-" : join(stats.frames_to_reacquire).c_str());
+    std::printf("startup_ms        %.1f\n", run.startup_ms);
     std::printf("median_ms         %.2f\n", kct::median(run.frame_ms));
 
     // Score the frames that have ground truth (pose.txt may hold more lines than images).

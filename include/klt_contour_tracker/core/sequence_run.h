@@ -42,6 +42,9 @@ struct SequenceRun {
   std::vector<std::string> frame_errors;  ///< "file: reason" of each frame that could not be used
   int extrapolated = 0;                   ///< frames whose preliminary pose was extrapolated
   SessionStatistics statistics;           ///< losses, re-acquisitions... of the session
+  /// Wall time of the session's start (its tracker and visibility table: built, or read from
+  /// the cache), ms; what a nodelet spends before its first frame.
+  double startup_ms = 0.0;
   PinholeCamera camera;                   ///< from K.txt and the first frame's size
 };
 
