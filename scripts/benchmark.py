@@ -655,10 +655,10 @@ def opt_sequence(data, obj, group, speed):
 
 
 def startup_ms(folder, model, preset, cache_dir):
-    """Session start-up (tracker + visibility table) of track_sequence on one frame, ms."""
+    """Session start-up (tracker + visibility table) of track_sequence on two frames, ms."""
     out = os.path.join(cache_dir, "startup.json")
     cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder, "--model", model,
-           "--preset", preset, "--param", "visibility_cache_dir=" + cache_dir, "--max-frames", "1",
+           "--preset", preset, "--param", "visibility_cache_dir=" + cache_dir, "--max-frames", "2",
            "--summary-json", out, "--quiet"]
     if subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
         return None
