@@ -41,6 +41,18 @@ while [ $# -gt 0 ]; do
   esac
 done
 "$KCT_ROOT/scripts/setup.sh"
+# The real section's ViSP sequences and CAD models (Debian's visp-images-data, ~100 MB): needed
+# by the benchmark only, so setup.sh (tests, demo) leaves it out.
+if ! dpkg-query -W -f='${Status}' visp-images-data 2>/dev/null | grep -q "install ok installed"; then
+  if [ "$(id -u)" -eq 0 ]; then
+    log "benchmark: installing visp-images-data (the real section's sequences)"
+    DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends -o DPkg::Lock::Timeout=600 \
+      visp-images-data || { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y \
+      --no-install-recommends visp-images-data; } || log "benchmark: visp-images-data not installed: the real section is skipped"
+  else
+    log "benchmark: visp-images-data is missing (run as root to install it): the real section is skipped"
+  fi
+fi
 "$KCT_ROOT/scripts/build.sh"
 source_ws
 export KCT_DATA

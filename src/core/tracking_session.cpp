@@ -183,9 +183,12 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
     features_confirm_ = true;
     return;
   }
-  // A pose from many features that disagrees with the held one replaces it: the track is the
-  // one anchored on something else (KLT anchors laid at a wrong pose hold it there).
+  // A pose from many features that disagrees with the held one replaces it when the track is in
+  // doubt (KLT failed on this frame, or the last frame was bad): its anchors may lie on
+  // something else. A confident track is kept: repeated texture (Castle-simu's bricks) gives
+  // 25 consistent but wrong matches.
   if (found.inliers < params_.relocalization_override_inliers) return;
+  if (status == TrackStatus::kKeypoints && monitor_.last_good()) return;
   TrackResult located;
   located.status = TrackStatus::kReacquired;
   located.object_to_camera = located.preliminary_object_to_camera = found.object_to_camera;

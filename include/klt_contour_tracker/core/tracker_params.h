@@ -117,8 +117,9 @@ struct TrackerParams {
   /// ours (tracking session, feature_relocalizer.h): ORB features of keyframes (the initial
   /// pose, then good frames from new viewpoints) anchored on the mesh; each frame they are
   /// matched around the tracked pose, and a PnP pose from at least
-  /// relocalization_override_inliers features that disagrees with the track replaces it; while
-  /// lost they are matched over the whole frame to re-acquire. Textured objects only (an
+  /// relocalization_override_inliers features that disagrees with a track in doubt (KLT failed
+  /// or the last frame was bad) replaces it; while lost they are matched over the whole frame to
+  /// re-acquire. Textured objects only (an
   /// untextured one never gives enough features: the option then does nothing).
   bool feature_relocalization = false;
   int relocalization_override_inliers = 25;  ///< PnP inliers needed to replace a held track
