@@ -654,16 +654,16 @@ def opt_sequence(data, obj, group, speed):
     return cached_run(cmd, folder, "rendering %s/%s" % (obj, seq_name(group, speed)))
 
 
-def startup_ms(folder, model, preset, cache_dir):
-    """Session start-up (tracker + visibility table) of track_sequence on two frames, ms."""
+def startup_run(folder, model, preset, cache_dir):
+    """track_sequence on two frames: its summary (startup_ms: tracker + visibility table, faces)."""
     out = os.path.join(cache_dir, "startup.json")
     cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder, "--model", model,
            "--preset", preset, "--param", "visibility_cache_dir=" + cache_dir, "--max-frames", "2",
            "--summary-json", out, "--quiet"]
     if subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
-        return None
+        return {}
     with open(out) as f:
-        return json.load(f).get("startup_ms")
+        return json.load(f)
 
 
 def startup_table(configs, objects, folders, sequences, data, tmp):
@@ -680,17 +680,16 @@ def startup_table(configs, objects, folders, sequences, data, tmp):
         model = os.path.join(data, "models", OBJECTS[o]["model"] + ".obj")
         folder = folders[(o,) + tuple(sequences[0])]
         cells = []
-        faces = "-"
+        faces = None
         for p in presets:
             cache = os.path.join(tmp, "startup_cache_%s_%s" % (o, p))
             subprocess.run(["rm", "-rf", cache])
             os.makedirs(cache)
-            first = startup_ms(folder, model, p, cache)
-            cached = startup_ms(folder, model, p, cache)
-            cells += [fmt(first, 0), fmt(cached, 0)]
-        with open(model) as f:
-            faces = str(sum(1 for line in f if line.startswith("f ")))
-        L.append("| %s | %s | %s |" % (o, faces, " | ".join(cells)))
+            first = startup_run(folder, model, p, cache)
+            cached = startup_run(folder, model, p, cache)
+            cells += [fmt(first.get("startup_ms"), 0), fmt(cached.get("startup_ms"), 0)]
+            faces = faces or first.get("faces")
+        L.append("| %s | %s | %s |" % (o, faces or "-", " | ".join(cells)))
     L.append("")
     return L
 

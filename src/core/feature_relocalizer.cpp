@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "klt_contour_tracker/core/check_range.h"
+#include "klt_contour_tracker/core/pose_cv.h"
 #include "klt_contour_tracker/core/surface_anchor.h"
 
 namespace kct {
@@ -179,13 +179,7 @@ Relocalization FeatureRelocalizer::locate(const cv::Mat& gray, const PinholeCame
     inlier_image.push_back(image_points[i]);
   }
   cv::solvePnPRefineLM(inlier_object, inlier_image, camera.K(), cv::noArray(), rvec, tvec);
-  cv::Mat rotation;
-  cv::Rodrigues(rvec, rotation);
-  Eigen::Matrix3d r;
-  cv::cv2eigen(rotation, r);
-  Pose pose = Pose::Identity();
-  pose.linear() = r;
-  pose.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  const Pose pose = pose_from_rvec_tvec(rvec, tvec);
   if (!is_valid_pose(pose) || !(pose.translation().z() > 0)) return result;
   double error_sum = 0.0;
   int in_front = 0;

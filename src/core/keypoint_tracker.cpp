@@ -1,5 +1,6 @@
 #include "klt_contour_tracker/core/keypoint_tracker.h"
 
+#include "klt_contour_tracker/core/pose_cv.h"
 #include "klt_contour_tracker/core/search_area.h"
 #include "klt_contour_tracker/core/surface_anchor.h"
 
@@ -7,33 +8,10 @@
 #include <chrono>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
 namespace kct {
-namespace {
-
-Pose pose_from_rvec_tvec(const cv::Mat& rvec, const cv::Mat& tvec) {
-  cv::Mat rotation;
-  cv::Rodrigues(rvec, rotation);
-  Eigen::Matrix3d r;
-  cv::cv2eigen(rotation, r);
-  Pose pose = Pose::Identity();
-  pose.linear() = r;
-  pose.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
-  return pose;
-}
-
-void pose_to_rvec_tvec(const Pose& pose, cv::Mat& rvec, cv::Mat& tvec) {
-  cv::Mat rotation;
-  cv::eigen2cv(Eigen::Matrix3d(pose.linear()), rotation);
-  cv::Rodrigues(rotation, rvec);
-  tvec = (cv::Mat_<double>(3, 1) << pose.translation().x(), pose.translation().y(),
-          pose.translation().z());
-}
-
-}  // namespace
 
 bool refined_pose_agrees_with_keypoints(const KeypointResult& keypoints, const Pose& refined,
                                         const PinholeCamera& camera, double max_increase_px) {

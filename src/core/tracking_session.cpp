@@ -99,7 +99,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     if (static_cast<int>(found.size()) > params_.color_search_placements)
       found.resize(static_cast<std::size_t>(params_.color_search_placements));
     std::vector<Pose> hypotheses{last_good};
-    const Eigen::Vector3d center_object = mesh_->bounding_box_center();
+    const Eigen::Vector3d& center_object = tracker_->center_object();
     const double angle = params_.color_search_rotation_deg * M_PI / 180.0;
     for (const SearchCandidate& candidate : found) {
       const Pose& placed = candidate.object_to_camera;
@@ -156,13 +156,19 @@ bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, Sessio
   if (relocalizer_->keyframes() == 0) return false;
   const Relocalization found = relocalizer_->locate(gray, tracker_->camera());
   if (!found.found) return false;
+  adopt_relocalized(frame, found.object_to_camera, 0.0, result);
+  return true;
+}
+
+void TrackingSession::adopt_relocalized(const Frame& frame, const Pose& object_to_camera,
+                                        double frame_time_ms, SessionResult& result) {
   TrackResult located;
   located.status = TrackStatus::kReacquired;
-  located.object_to_camera = located.preliminary_object_to_camera = found.object_to_camera;
+  located.object_to_camera = located.preliminary_object_to_camera = object_to_camera;
+  located.frame_time_ms = frame_time_ms;
   tracker_->adopt(frame, located);
   result.frame = located;
   result.relocalized = true;
-  return true;
 }
 
 void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
@@ -176,7 +182,7 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   const Relocalization found =
       relocalizer_->locate(gray, camera, relocalizer_->region_around(held, camera, kRegionMargin));
   if (!found.found) return;
-  const Eigen::Vector3d center = mesh_->bounding_box_center();
+  const Eigen::Vector3d& center = tracker_->center_object();
   const double moved_m = ((found.object_to_camera * center) - (held * center)).norm();
   if (moved_m < kAgreementDiameters * tracker_->diameter_m() &&
       rotation_error_deg(found.object_to_camera, held) < kAgreementDeg) {
@@ -189,13 +195,7 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   // 25 consistent but wrong matches.
   if (found.inliers < params_.relocalization_override_inliers) return;
   if (status == TrackStatus::kKeypoints && monitor_.last_good()) return;
-  TrackResult located;
-  located.status = TrackStatus::kReacquired;
-  located.object_to_camera = located.preliminary_object_to_camera = found.object_to_camera;
-  located.frame_time_ms = result.frame.frame_time_ms;
-  tracker_->adopt(frame, located);
-  result.frame = located;
-  result.relocalized = true;
+  adopt_relocalized(frame, found.object_to_camera, result.frame.frame_time_ms, result);
 }
 
 void TrackingSession::add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result) {

@@ -120,6 +120,8 @@ class Tracker {
   std::string check_frame(const Frame& frame) const;
   /// Mesh diameter, metres (computed once).
   double diameter_m() const { return diameter_m_; }
+  /// The mesh's bounding-box centre, object frame, metres (computed once).
+  const Eigen::Vector3d& center_object() const { return center_object_; }
   /// Last pose output (valid when is_initialized()).
   const Pose& last_pose() const { return pose_i1_; }
 

@@ -112,6 +112,10 @@ class TrackingSession {
   /// feature_relocalization, while lost: the keyframes' features over the whole frame; true
   /// when they re-acquired the object (`result` then holds it).
   bool relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result);
+  /// The tracker continues from the relocalizer's `object_to_camera`; `result` reports it
+  /// (kReacquired, relocalized) with `frame_time_ms` so far.
+  void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, double frame_time_ms,
+                         SessionResult& result);
   /// Adds a keyframe on the initial frame and on confident frames seen from a new viewpoint.
   void add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result);
   /// The colour model's evidence for `result` and its learning on good frames (color_search).
