@@ -22,7 +22,6 @@ import json
 import os
 import platform
 import shlex
-import statistics
 import subprocess
 import sys
 import time
@@ -375,9 +374,9 @@ def session_cells(rows):
     within = sum(1 for f in frames if f <= REACQUIRE_WITHIN_FRAMES)
     losses = sum(int(r.get("losses", 0)) for r in rows)
     share = " (%d %%)" % round(100.0 * within / losses) if losses else ""
-    median = "%g" % statistics.median(frames) if frames else "-"
+    middle = median(frames)
     return [str(losses), str(sum(int(r.get("reacquisitions", 0)) for r in rows)), "%d%s" % (within, share),
-            median, str(sum(int(r.get("frames_lost", 0)) for r in rows))]
+            "%g" % middle if middle is not None else "-", str(sum(int(r.get("frames_lost", 0)) for r in rows))]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -492,10 +491,12 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
     keys = session_counts(rows)
     if keys:
         L.append("### Losses and re-acquisitions (tracking session)\n")
+        leave_args = HARD_CONDITIONS["leave"][1]
         L.append("A loss: the session's state goes from tracking to lost; re-acquired: it tracks again "
                  "before the sequence ends; *within %d frames*: counted from the loss, so the frames the "
-                 "object spends outside the image (leave: 14) or behind the occluder count too; the "
-                 "median is over the re-acquired losses.\n" % REACQUIRE_WITHIN_FRAMES)
+                 "object spends outside the image (leave: %s) or behind the occluder count too; the "
+                 "median is over the re-acquired losses.\n"
+                 % (REACQUIRE_WITHIN_FRAMES, leave_args[leave_args.index("--leave-frames") + 1]))
         L.append("| preset | condition | " + " | ".join(keys) + " |")
         L.append("|---|---|" + "---|" * len(keys))
         for p in labels:
