@@ -43,12 +43,16 @@ CoarseToFineResult CoarseToFineOptimizer::minimize(PoseCostSum& cost, const Pose
         // A tiny floor keeps directions no cue constrains from exploding.
         const double floor = 1e-9 * hessian.diagonal().maxCoeff();
         for (int i = 0; i < 6; ++i) damped(i, i) += damping * hessian(i, i) + floor;
-        const Vector6d delta = damped.ldlt().solve(-gradient);
+        Vector6d delta = damped.ldlt().solve(-gradient);
         if (!delta.allFinite()) break;
+        step_px = delta.head<3>().norm() * px_per_rad + delta.tail<3>().norm() * px_per_m;
+        if (settings.max_step_px > 0.0 && step_px > settings.max_step_px) {
+          delta *= settings.max_step_px / step_px;
+          step_px = settings.max_step_px;
+        }
         const Pose candidate = apply_pose_increment(pose, delta, frame.center_object);
         const double candidate_value = cost.evaluate(candidate, nullptr, nullptr);
         ++result.evaluations;
-        step_px = delta.head<3>().norm() * px_per_rad + delta.tail<3>().norm() * px_per_m;
         if (candidate_value < value) {
           pose = candidate;
           damping = std::max(1e-6, damping * 0.3);

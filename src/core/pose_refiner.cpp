@@ -186,6 +186,7 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
   cost_frame_.keypoints = keypoints && keypoints->success ? keypoints : nullptr;
   CoarseToFineSettings settings;
   settings.iterations_per_level = params_.iterations_per_level;
+  settings.max_step_px = params_.max_step_px;
   const CoarseToFineOptimizer optimizer;
   // begin_frame() already ran in prepare_frame(): the optimizer must not repeat it.
   // Starts: the preliminary pose and, without keypoints, the best image-plane shift of it

@@ -1,11 +1,13 @@
 // The `realtime` refinement (coarse-to-fine Levenberg-Marquardt on the weighted cues) on rendered
 // frames with known poses: a perturbed pose is brought back with and without keypoints, the
-// keypoint cue keeps the pose on good keypoints, and nothing depends on the thread count.
+// keypoint cue keeps the pose on good keypoints, a step along a nearly flat direction is bounded,
+// and nothing depends on the thread count.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include "klt_contour_tracker/core/coarse_to_fine_optimizer.h"
+#include "klt_contour_tracker/core/motion_model.h"
 #include "klt_contour_tracker/core/pose_refiner.h"
 #include "klt_contour_tracker/core/tracker.h"
 #include "synthetic_scene.h"
@@ -107,6 +109,67 @@ TEST_F(CoarseToFineTest, NoTermsNoMove) {
   EXPECT_THROW(CoarseToFineOptimizer().minimize(empty, PoseCostFrame(), truth_, 0.1,
                                                 CoarseToFineSettings()),
                std::invalid_argument);
+}
+
+/// A cue with a nearly flat, sloped direction: a rotation about `axis` (not a coordinate axis),
+/// curvature `flat_curvature`, slope `slope`; every other direction has curvature 1. Its
+/// minimum lies at a rotation of slope / flat_curvature rad about -axis.
+class FlatDirectionCost : public PoseCost {
+ public:
+  FlatDirectionCost(const Pose& start, const Eigen::Vector3d& axis, double slope,
+                    double flat_curvature)
+      : start_(start), axis_(axis.normalized()), slope_(slope), flat_(flat_curvature) {}
+  std::string name() const override { return "flat"; }
+  void begin_frame(const PoseCostFrame& frame) override { center_ = frame.center_object; }
+  void linearize(const Pose&, int) override {}
+  double evaluate(const Pose& pose, Vector6d* gradient, Matrix6d* hessian) const override {
+    const Vector6d e = motion_increment_between(start_, pose, center_);
+    Vector6d u = Vector6d::Zero();
+    u.head<3>() = axis_;
+    const double along = u.dot(e);
+    const Vector6d across = e - along * u;
+    if (gradient) *gradient += (slope_ + flat_ * along) * u + across;
+    if (hessian) *hessian += flat_ * u * u.transpose() + (Matrix6d::Identity() - u * u.transpose());
+    return slope_ * along + 0.5 * flat_ * along * along + 0.5 * across.squaredNorm();
+  }
+
+ private:
+  Pose start_;
+  Eigen::Vector3d axis_;
+  double slope_, flat_;
+  Eigen::Vector3d center_ = Eigen::Vector3d::Zero();
+};
+
+TEST(CoarseToFineStep, MaxStepBoundsAStepAlongANearlyFlatDirection) {
+  // One full-resolution linearization: unbounded, the step heads for the cue's minimum 1.5 rad
+  // (86 deg) away (Marquardt's damping of the off-axis diagonal shortens it to ~49 deg), as the
+  // can's blurred outline let it turn 145 deg; with max_step_px = 8 the model points move by
+  // at most 8 px, along the same axis.
+  const PinholeCamera camera = test::make_camera();
+  const Pose start = test::make_pose(0.45);
+  PoseCostFrame frame;
+  frame.levels = make_pyramid(cv::Mat(camera.size(), CV_8UC1, cv::Scalar(0)), camera, 1);
+  frame.center_object = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d axis(1.0, 1.0, 0.0);
+  PoseCostSum cost;
+  cost.add(std::make_shared<FlatDirectionCost>(start, axis, 1e-3, 1e-3 / 1.5), 1.0);
+  const double radius_m = 0.07;
+  CoarseToFineSettings settings;
+  settings.iterations_per_level = 1;
+  const CoarseToFineOptimizer optimizer;
+  const Pose unbounded =
+      optimizer.minimize(cost, frame, start, radius_m, settings).object_to_camera;
+  EXPECT_GT(rotation_error_deg(unbounded, start), 30.0);
+  settings.max_step_px = 8.0;
+  const Pose bounded = optimizer.minimize(cost, frame, start, radius_m, settings).object_to_camera;
+  const double px_per_rad = camera.fx() * radius_m / (start * frame.center_object).z();
+  const double bound_deg = 8.0 / px_per_rad * 180.0 / M_PI;  // 5.5 deg
+  // Tolerance: 1e-6 deg of round-off; the step still lowers the cost, so it is taken.
+  EXPECT_LE(rotation_error_deg(bounded, start), bound_deg + 1e-6);
+  EXPECT_GT(rotation_error_deg(bounded, start), 0.99 * bound_deg);
+  const Vector6d e = motion_increment_between(start, bounded, frame.center_object);
+  EXPECT_GT(-e.head<3>().normalized().dot(axis.normalized()), 0.999);  // the same direction
+  EXPECT_LT(e.tail<3>().norm(), 1e-9);
 }
 
 TEST(CoarseToFineTracker, ResultDoesNotDependOnTheThreadCount) {

@@ -110,7 +110,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 72u);
+  EXPECT_EQ(fields.size(), 73u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

@@ -16,6 +16,12 @@ struct CoarseToFineSettings {
   double convergence_px = 0.05;
   double initial_damping = 1e-3;  ///< LM lambda relative to diag(H) at the start of a level
   int max_rejected_steps = 4;     ///< rejected (cost-increasing) steps per iteration
+  /// A step that would move a model point by more than this (level px, estimated as for
+  /// convergence_px) is shortened to it, direction kept (0 = no limit). Marquardt's
+  /// lambda diag(H) does not bound a step along a direction of near-zero curvature that is not
+  /// a coordinate axis (a can turning about its own axis, whose outline does not change): the
+  /// solve then returns an arbitrarily long step driven by noise.
+  double max_step_px = 0.0;
 };
 
 /// Outcome of CoarseToFineOptimizer::minimize().

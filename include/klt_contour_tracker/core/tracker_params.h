@@ -175,6 +175,12 @@ struct TrackerParams {
   /// coarse px). Hard section (realtime, 24 sequences): 0 -> 10.62 mean AUC, 0.5 -> 10.75,
   /// 0.8 -> 10.86 (sensor effects 5.78 -> 7.86); no change on the OPT-style quick sequences.
   double shift_search_diameters = 0.0;
+  /// ours (0 = no limit): a coarse_to_fine step moves a model point by at most this many px of
+  /// its pyramid level (CoarseToFineSettings::max_step_px). Without it a blurred frame with no
+  /// keypoints turned the can 145 deg about its own axis in one step (hard/can/occlusion,
+  /// frame 1; with 8: 8 deg). Hard + second hard set (48 sequences, realtime): no limit 11.29
+  /// mean AUC, 4 px 10.91, 8 px 11.29, 16 px 11.15: a safeguard, not a gain on the benchmark.
+  double max_step_px = 0.0;
   /// ours: threads the tracker may use (KLT overlapped with the refinement's image work,
   /// pyramid levels in parallel); results do not depend on it.
   int num_threads = 1;
