@@ -17,6 +17,7 @@ one page fragment per section (docs/benchmarks/<section>.md), docs/benchmarks.md
 them) and the PNG success curves in docs/benchmarks/. Python standard library only.
 """
 import argparse
+import csv
 import datetime
 import json
 import os
@@ -259,7 +260,8 @@ class Runner:
         cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder, "--model", model,
                "--preset", preset,
                "--param", "visibility_cache_dir=" + os.path.join(self.repo, "data", "cache", "visibility"),
-               "--output", base + ".poses.txt", "--summary-json", base + ".json", "--quiet"]
+               "--output", base + ".poses.txt", "--summary-json", base + ".json",
+               "--trace", base + ".trace.csv", "--quiet"]
         with open(os.path.join(folder, "pose.txt")) as f:
             if len([l for l in f if l.strip() and not l.startswith("#")]) > 1:  # ground truth
                 cmd += ["--errors", base + ".errors.txt"]
@@ -273,7 +275,7 @@ class Runner:
         if label in self.reuse and os.path.exists(base + ".json"):
             pass  # --reuse: the previous run's result of this configuration
         else:
-            for f in (base + ".json", base + ".errors.txt"):
+            for f in (base + ".json", base + ".errors.txt", base + ".trace.csv"):
                 if os.path.exists(f):
                     os.remove(f)
             proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -289,6 +291,12 @@ class Runner:
         if os.path.exists(base + ".errors.txt"):
             with open(base + ".errors.txt") as f:
                 summary["errors"] = [float(x) for x in f.read().split()]
+        # The session's per-frame verdict (the trace's `good`: what ~status tells a ROS user),
+        # absent from results made before the trace was written.
+        summary["good"] = None
+        if os.path.exists(base + ".trace.csv"):
+            with open(base + ".trace.csv") as f:
+                summary["good"] = [row["good"] == "1" for row in csv.DictReader(f)]
         summary.update(preset=label, wall_s=time.time() - t0, poses_file=base + ".poses.txt")
         return summary
 
@@ -366,6 +374,36 @@ def session_counts(rows):
     return SESSION_COLUMNS if any("losses" in r for r in rows) else []
 
 
+# A pose whose error is at least this share of the object's diameter is wrong (AUC counts it at
+# most half; ADD-0.1d, the common pass mark, fails it).
+WRONG_POSE_DIAMETERS = 0.1
+VERDICT_COLUMNS = ["scored frames", "reported good", "good but wrong", "AUC lost on them",
+                   "reported bad", "bad but right"]
+
+
+def verdict_cells(rows):
+    """How far the session's per-frame verdict (good / bad) can be trusted, over the scored frames
+    of `rows` (each with `good_scored`: (good, normalized error) pairs): frames reported good,
+    those of them whose pose is wrong (error >= WRONG_POSE_DIAMETERS diameters) and the AUC
+    points they cost the whole set, frames reported bad and those of them that were right.
+    None when a row has no trace."""
+    if any(r.get("good_scored") is None for r in rows):
+        return None
+    pairs = [p for r in rows for p in r["good_scored"]]
+    if not pairs:
+        return None
+    good = [e for g, e in pairs if g]
+    bad = [e for g, e in pairs if not g]
+    wrong = [e for e in good if e >= WRONG_POSE_DIAMETERS]
+    right_bad = [e for e in bad if e < WRONG_POSE_DIAMETERS]
+    lost = sum(20.0 - 100.0 * max(0.0, 0.2 - e) for e in wrong) / len(pairs)
+
+    def share(part, whole):
+        return "%d (%d %%)" % (len(part), round(100.0 * len(part) / len(whole))) if whole else "0"
+    return [str(len(pairs)), share(good, pairs), share(wrong, good), "%.2f" % lost, share(bad, pairs),
+            share(right_bad, bad)]
+
+
 def session_cells(rows):
     """Losses, re-acquisitions (all; within REACQUIRE_WITHIN_FRAMES, share of the losses), the
     median number of frames from a loss to its re-acquisition and the frames spent lost, summed
@@ -424,6 +462,9 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
                 continue
             visible = [float(l) for l in open(os.path.join(folder, "visible.txt")) if not l.startswith("#")]
             scored = [e for e, v in zip(r["errors"], visible) if v >= HARD_MIN_VISIBLE]
+            good = r.get("good")
+            r["good_scored"] = None if good is None or len(good) != len(r["errors"]) else [
+                (g, e / r["diameter_m"]) for g, e, v in zip(good, r["errors"], visible) if v >= HARD_MIN_VISIBLE]
             r.update(object=o, condition=c, auc=auc(scored, r["diameter_m"]), scored_frames=len(scored),
                      normalized_errors=[e / r["diameter_m"] for e in scored],
                      visible_errors=[(e if v >= HARD_MIN_VISIBLE else None) for e, v in zip(r["errors"], visible)])
@@ -503,6 +544,20 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
             for c in conditions:
                 L.append("| %s | %s | %s |" % (p, c, " | ".join(session_cells(sel(preset=p, condition=c)))))
             L.append("| %s | **all** | %s |" % (p, " | ".join(session_cells(sel(preset=p)))))
+        L.append("")
+    verdicts = [(p, verdict_cells(sel(preset=p))) for p in labels]
+    if any(cells for _, cells in verdicts):
+        L.append("### Can the verdict be trusted? (tracking session)\n")
+        L.append("Each frame's verdict is what `~status` tells a ROS user (the trace's `good`). Over the "
+                 "scored frames: *good but wrong* are frames reported good whose pose is off by at least "
+                 "%g x the diameter (what a robot acts on wrongly); *AUC lost on them* is what those frames "
+                 "cost the preset's AUC of 20; *bad but right* are frames reported bad whose pose was within "
+                 "that bound. Presets whose results predate the trace show no row.\n" % WRONG_POSE_DIAMETERS)
+        L.append("| preset | " + " | ".join(VERDICT_COLUMNS) + " |")
+        L.append("|---|" + "---|" * len(VERDICT_COLUMNS))
+        for p, cells in verdicts:
+            if cells:
+                L.append("| %s | %s |" % (p, " | ".join(cells)))
         L.append("")
     L.append("### Speed\n")
     L.append("Median of the per-sequence median `track()` time per frame (first frame excluded), ms.\n")
