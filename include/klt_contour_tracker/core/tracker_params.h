@@ -179,7 +179,8 @@ struct TrackerParams {
   /// its pyramid level (CoarseToFineSettings::max_step_px). Without it a blurred frame with no
   /// keypoints turned the can 145 deg about its own axis in one step (hard/can/occlusion,
   /// frame 1; with 8: 8 deg). Hard + second hard set (48 sequences, realtime): no limit 11.29
-  /// mean AUC, 4 px 10.91, 8 px 11.29, 16 px 11.15: a safeguard, not a gain on the benchmark.
+  /// mean AUC, 4 px 10.91, 8 px 11.29 (hard 11.20 -> 11.10, second set 11.38 -> 11.47), 16 px
+  /// 11.15: a safeguard, not a gain on the benchmark.
   double max_step_px = 0.0;
   /// ours: threads the tracker may use (KLT overlapped with the refinement's image work,
   /// pyramid levels in parallel); results do not depend on it.
