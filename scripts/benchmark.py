@@ -374,6 +374,11 @@ def session_counts(rows):
     return SESSION_COLUMNS if any("losses" in r for r in rows) else []
 
 
+def count_share(count, whole):
+    """`count` and its share of `whole` as "n (p %)"; just n when `whole` is 0."""
+    return "%d (%d %%)" % (count, round(100.0 * count / whole)) if whole else str(count)
+
+
 # A pose whose error is at least this share of the object's diameter is wrong (AUC counts it at
 # most half; ADD-0.1d, the common pass mark, fails it).
 WRONG_POSE_DIAMETERS = 0.1
@@ -396,12 +401,11 @@ def verdict_cells(rows):
     bad = [e for g, e in pairs if not g]
     wrong = [e for e in good if e >= WRONG_POSE_DIAMETERS]
     right_bad = [e for e in bad if e < WRONG_POSE_DIAMETERS]
-    lost = sum(20.0 - 100.0 * max(0.0, 0.2 - e) for e in wrong) / len(pairs)
-
-    def share(part, whole):
-        return "%d (%d %%)" % (len(part), round(100.0 * len(part) / len(whole))) if whole else "0"
-    return [str(len(pairs)), share(good, pairs), share(wrong, good), "%.2f" % lost, share(bad, pairs),
-            share(right_bad, bad)]
+    # What the wrong frames cost the AUC of all frames: their shortfall from 20, weighted by
+    # their share of the frames.
+    lost = (20.0 - auc(wrong, 1.0)) * len(wrong) / len(pairs) if wrong else 0.0
+    return [str(len(pairs)), count_share(len(good), len(pairs)), count_share(len(wrong), len(good)),
+            "%.2f" % lost, count_share(len(bad), len(pairs)), count_share(len(right_bad), len(bad))]
 
 
 def session_cells(rows):
@@ -411,9 +415,9 @@ def session_cells(rows):
     frames = [int(f) for r in rows for f in r.get("frames_to_reacquire", [])]
     within = sum(1 for f in frames if f <= REACQUIRE_WITHIN_FRAMES)
     losses = sum(int(r.get("losses", 0)) for r in rows)
-    share = " (%d %%)" % round(100.0 * within / losses) if losses else ""
     middle = median(frames)
-    return [str(losses), str(sum(int(r.get("reacquisitions", 0)) for r in rows)), "%d%s" % (within, share),
+    return [str(losses), str(sum(int(r.get("reacquisitions", 0)) for r in rows)),
+            count_share(within, losses),
             "%g" % middle if middle is not None else "-", str(sum(int(r.get("frames_lost", 0)) for r in rows))]
 
 
