@@ -52,6 +52,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     # the colour verdict of a loss taken even while the contour energy or KLT says the pose holds
     ("realtime_no_color_veto", "realtime",
      {"color_contour_veto_ratio": "0", "color_keypoint_veto_inliers": "0"}),
+    # no check of turned rotations after a KLT failure or a re-acquisition
+    ("realtime_no_rotation_check", "realtime", {"rotation_check_deg": "0"}),
     # keypoints anchored after a KLT failure kept even when the frame is judged bad
     ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)

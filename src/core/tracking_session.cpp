@@ -1,5 +1,6 @@
 #include "klt_contour_tracker/core/tracking_session.h"
 
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -17,6 +18,24 @@ constexpr double kRegionMargin = 0.5;
 /// less than this many diameters apart and their rotations less than this many degrees.
 constexpr double kAgreementDiameters = 0.05;
 constexpr double kAgreementDeg = 5.0;
+/// rotation_check corrects the rotation: a turned hypothesis whose refined centre moved farther
+/// than this many diameters from the held one is not considered.
+constexpr double kRotationCheckMaxShiftDiameters = 0.2;
+
+/// `pose` turned by +-angle_rad about each camera axis through the object's centre.
+std::vector<Pose> turned_about_center(const Pose& pose, const Eigen::Vector3d& center_object,
+                                      double angle_rad) {
+  std::vector<Pose> turned;
+  const Eigen::Vector3d center_camera = pose * center_object;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double sign : {-1.0, 1.0}) {
+      Pose p = pose;
+      p.linear() = Eigen::AngleAxisd(sign * angle_rad, Eigen::Vector3d::Unit(axis)) * pose.linear();
+      p.translation() = center_camera - p.linear() * center_object;
+      turned.push_back(p);
+    }
+  return turned;
+}
 
 }  // namespace
 
@@ -58,6 +77,8 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   initialized_since_last_frame_ = true;
   lost_at_frame_ = -1;
   unconfirmed_.reset();
+  rotation_check_winner_ = -1;
+  frames_since_doubt_ = 1000;
 }
 
 void TrackingSession::reset() {
@@ -105,15 +126,8 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       const Pose& placed = candidate.object_to_camera;
       hypotheses.push_back(placed);
       if (angle <= 0.0) continue;
-      const Eigen::Vector3d center_camera = placed * center_object;
-      for (int axis = 0; axis < 3; ++axis)
-        for (const double sign : {-1.0, 1.0}) {
-          Pose turned = placed;
-          turned.linear() =
-              Eigen::AngleAxisd(sign * angle, Eigen::Vector3d::Unit(axis)) * placed.linear();
-          turned.translation() = center_camera - turned.linear() * center_object;
-          hypotheses.push_back(turned);
-        }
+      for (const Pose& turned : turned_about_center(placed, center_object, angle))
+        hypotheses.push_back(turned);
     }
     std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, hypotheses, 1.0);
     if (refined.front().status != TrackStatus::kReacquired) return refined.front();  // invalid frame
@@ -198,6 +212,48 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   adopt_relocalized(frame, found.object_to_camera, result.frame.frame_time_ms, result);
 }
 
+void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
+  const TrackResult& held = result.frame;
+  if (!(params_.rotation_check_deg > 0.0) || !search_ || !search_->ready() || bgr.empty() ||
+      !held.refined || monitor_.color_level() < TrackQualityMonitor::kMinColorLevel ||
+      (held.status != TrackStatus::kKeypoints && held.status != TrackStatus::kExtrapolated) ||
+      frames_since_doubt_ > params_.rotation_check_frames)
+    return;
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<Pose> turned = turned_about_center(
+      held.object_to_camera, tracker_->center_object(), params_.rotation_check_deg * M_PI / 180.0);
+  std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, turned, 1.0);
+  std::vector<Pose> poses{held.object_to_camera};
+  for (const TrackResult& r : refined) poses.push_back(r.object_to_camera);
+  const std::vector<SearchCandidate> scored = search_->score(bgr, poses, tracker_->camera());
+  const Eigen::Vector3d& center = tracker_->center_object();
+  const Eigen::Vector3d held_center = held.object_to_camera * center;
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < scored.size(); ++i)
+    if (refined[i - 1].refined && refined[i - 1].energy_after >= held.energy_after &&
+        (poses[i] * center - held_center).norm() < kRotationCheckMaxShiftDiameters * tracker_->diameter_m() &&
+        scored[i].contrast >= params_.color_accept_ratio * monitor_.color_level() &&
+        scored[i].contrast >= scored[0].contrast + params_.rotation_check_margin * monitor_.color_level() &&
+        scored[i].contrast > scored[best].contrast)
+      best = i;
+  const double elapsed_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  // The same turn must win on two consecutive frames: a single win is often colour noise.
+  const int winner = static_cast<int>(best) - 1;
+  const bool confirmed = winner >= 0 && winner == rotation_check_winner_;
+  rotation_check_winner_ = winner;
+  if (!confirmed) {
+    result.frame.frame_time_ms += elapsed_ms;
+    return;
+  }
+  rotation_check_winner_ = -1;
+  TrackResult chosen = refined[best - 1];
+  chosen.frame_time_ms = held.frame_time_ms + elapsed_ms;
+  tracker_->adopt(frame, chosen);
+  result.frame = chosen;
+  result.rotation_corrected = true;
+}
+
 void TrackingSession::add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result) {
   if (!result.has_pose()) return;
   const TrackResult& f = result.frame;
@@ -263,6 +319,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
     result.frame =
         result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
     if (!gray.empty()) use_features(frame, gray, result);
+    if (!result.reacquiring && !result.relocalized) check_rotation(frame, bgr, result);
   }
   use_colors(bgr, result);
   ColorLossRule rule;
@@ -275,6 +332,10 @@ SessionResult TrackingSession::track(const Frame& frame) {
       !monitor_.last_good())
     tracker_->forget_keypoints();
   if (!gray.empty()) add_keyframe_if_due(gray, result);
+  // rotation_check's window: frames since KLT last failed or the track was re-acquired.
+  const bool doubt = result.frame.status == TrackStatus::kExtrapolated ||
+                     result.frame.status == TrackStatus::kReacquired;
+  frames_since_doubt_ = doubt ? 0 : frames_since_doubt_ + 1;
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();

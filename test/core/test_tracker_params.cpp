@@ -39,6 +39,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.keypoint_motion_gate_sigmas, 0.0);
   EXPECT_DOUBLE_EQ(p.motion_prior_weight, 0.0);
   EXPECT_DOUBLE_EQ(p.region_weight, 0.0);
+  EXPECT_DOUBLE_EQ(p.rotation_check_deg, 0.0);
 }
 
 TEST(TrackerParams, CueFieldsAreValidated) {
@@ -58,6 +59,9 @@ TEST(TrackerParams, CueFieldsAreValidated) {
   EXPECT_TRUE(rejects("keypoint_motion_gate_sigmas", "-2"));
   EXPECT_TRUE(rejects("motion_prior_weight", "-0.1"));
   EXPECT_TRUE(rejects("region_weight", "-1"));
+  EXPECT_TRUE(rejects("rotation_check_deg", "-5"));
+  EXPECT_TRUE(rejects("rotation_check_frames", "0"));
+  EXPECT_TRUE(rejects("rotation_check_margin", "-0.1"));
   EXPECT_TRUE(rejects("region_line_half_length_px", "1"));
   EXPECT_TRUE(rejects("region_line_spacing_px", "0"));
   EXPECT_TRUE(rejects("region_band_px", "0"));
@@ -110,7 +114,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 73u);
+  EXPECT_EQ(fields.size(), 76u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

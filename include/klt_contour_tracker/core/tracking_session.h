@@ -34,6 +34,8 @@ struct SessionResult {
   /// The pose came from the feature relocalizer (feature_relocalization): a re-acquisition
   /// while lost, or a held track it replaced.
   bool relocalized = false;
+  /// rotation_check replaced the tracked pose by a turned one that the colours fit better.
+  bool rotation_corrected = false;
   ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
   bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
   bool restarted = false;    ///< ... and the session restarted from restart_pose()
@@ -116,6 +118,10 @@ class TrackingSession {
   /// (kReacquired, relocalized) with `frame_time_ms` so far.
   void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, double frame_time_ms,
                          SessionResult& result);
+  /// rotation_check: the tracked pose turned by +-rotation_check_deg about camera axes, each
+  /// refined; one whose colour contrast beats the held pose's by the margin (and whose contour
+  /// energy is no lower) replaces it and the keypoints are anchored afresh.
+  void check_rotation(const Frame& frame, const cv::Mat& bgr, SessionResult& result);
   /// Adds a keyframe on the initial frame and on confident frames seen from a new viewpoint.
   void add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result);
   /// The colour model's evidence for `result` and its learning on good frames (color_search).
@@ -132,6 +138,8 @@ class TrackingSession {
   /// only on such a frame, so that a wrong track never becomes a keyframe).
   bool features_confirm_ = false;
   int frames_since_learning_ = 0;
+  int rotation_check_winner_ = -1;  ///< the turn that won rotation_check on the last frame
+  int frames_since_doubt_ = 1000;  ///< frames since KLT last failed or a re-acquisition
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
   bool has_last_stamp_ = false;
