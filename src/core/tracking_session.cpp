@@ -22,6 +22,10 @@ constexpr double kAgreementDeg = 5.0;
 /// than this many diameters from the held one is not considered.
 constexpr double kRotationCheckMaxShiftDiameters = 0.2;
 
+double elapsed_ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
 /// `pose` turned by +-angle_rad about each camera axis through the object's centre.
 std::vector<Pose> turned_about_center(const Pose& pose, const Eigen::Vector3d& center_object,
                                       double angle_rad) {
@@ -166,11 +170,15 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 
-bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
+bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result,
+                                  double& spent_ms) {
+  spent_ms = 0.0;
   if (relocalizer_->keyframes() == 0) return false;
+  const auto start = std::chrono::steady_clock::now();
   const Relocalization found = relocalizer_->locate(gray, tracker_->camera());
+  spent_ms = elapsed_ms_since(start);
   if (!found.found) return false;
-  adopt_relocalized(frame, found.object_to_camera, 0.0, result);
+  adopt_relocalized(frame, found.object_to_camera, spent_ms, result);
   return true;
 }
 
@@ -193,8 +201,11 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
     return;
   const Pose& held = result.frame.object_to_camera;
   const PinholeCamera& camera = tracker_->camera();
+  // The matching is part of the frame's work: its time counts in frame_time_ms.
+  const auto start = std::chrono::steady_clock::now();
   const Relocalization found =
       relocalizer_->locate(gray, camera, relocalizer_->region_around(held, camera, kRegionMargin));
+  result.frame.frame_time_ms += elapsed_ms_since(start);
   if (!found.found) return;
   const Eigen::Vector3d& center = tracker_->center_object();
   const double moved_m = ((found.object_to_camera * center) - (held * center)).norm();
@@ -236,8 +247,7 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
         scored[i].contrast >= scored[0].contrast + params_.rotation_check_margin * monitor_.color_level() &&
         scored[i].contrast > scored[best].contrast)
       best = i;
-  const double elapsed_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double elapsed_ms = elapsed_ms_since(start);
   // The same turn must win on two consecutive frames: a single win is often colour noise.
   const int winner = static_cast<int>(best) - 1;
   const bool confirmed = winner >= 0 && winner == rotation_check_winner_;
@@ -315,9 +325,11 @@ SessionResult TrackingSession::track(const Frame& frame) {
   if (relocalizer_ && tracker_->check_frame(frame).empty())
     gray = tracker_->undistorted_gray(frame.image);
   features_confirm_ = false;
-  if (!(result.reacquiring && !gray.empty() && relocalize(frame, gray, result))) {
+  double relocalize_ms = 0.0;
+  if (!(result.reacquiring && !gray.empty() && relocalize(frame, gray, result, relocalize_ms))) {
     result.frame =
         result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
+    result.frame.frame_time_ms += relocalize_ms;  // a search of the keyframes that found nothing
     if (!gray.empty()) use_features(frame, gray, result);
     if (!result.reacquiring && !result.relocalized) check_rotation(frame, bgr, result);
   }
