@@ -1,5 +1,6 @@
 #include "klt_contour_tracker/core/keypoint_tracker.h"
 
+#include "klt_contour_tracker/core/elapsed.h"
 #include "klt_contour_tracker/core/pose_cv.h"
 #include "klt_contour_tracker/core/search_area.h"
 #include "klt_contour_tracker/core/surface_anchor.h"
@@ -164,9 +165,6 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
                                       const KeypointPrediction* prediction) {
   KeypointResult result;
   const auto start = std::chrono::steady_clock::now();
-  auto since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-  };
   const int steps = downscale_steps(gray.size());
   const double s = std::ldexp(1.0, -steps);
   const cv::Mat small = downscale(gray, steps);
@@ -266,7 +264,7 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   image_points_ = tracked_image;
   object_points_ = tracked_object;
   result.tracked = static_cast<int>(tracked_image.size());
-  result.klt_ms = since(start);
+  result.klt_ms = elapsed_ms(start);
   if (result.tracked < std::max(params_.klt_min_points, 4)) return result;
   const auto pnp_start = std::chrono::steady_clock::now();
 
@@ -278,7 +276,7 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
       /*useExtrinsicGuess=*/true, params_.ransac_iterations,
       static_cast<float>(params_.ransac_reprojection_px), 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
   if (!solved || inliers.size() < 4) {
-    result.pnp_ms = since(pnp_start);
+    result.pnp_ms = elapsed_ms(pnp_start);
     return result;
   }
 
@@ -315,7 +313,7 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
     image_points_ = inlier_image;
     object_points_ = inlier_object;
   }
-  result.pnp_ms = since(pnp_start);
+  result.pnp_ms = elapsed_ms(pnp_start);
   return result;
 }
 

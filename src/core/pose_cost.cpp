@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "klt_contour_tracker/core/elapsed.h"
+
 namespace kct {
 
 Pose apply_pose_increment(const Pose& object_to_camera, const Vector6d& delta,
@@ -60,13 +62,6 @@ std::vector<PyramidLevel> make_pyramid(const cv::Mat& gray, const PinholeCamera&
   }
   return pyramid;
 }
-
-namespace {
-double elapsed_ms(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-      .count();
-}
-}  // namespace
 
 void PoseCostSum::add(std::shared_ptr<PoseCost> cue, double weight) {
   if (!cue) throw std::invalid_argument("PoseCostSum::add: cue is null");

@@ -9,6 +9,7 @@
 #include "klt_contour_tracker/core/contour_cost.h"
 #include "klt_contour_tracker/core/contour_energy.h"
 #include "klt_contour_tracker/core/contour_extractor.h"
+#include "klt_contour_tracker/core/elapsed.h"
 #include "klt_contour_tracker/core/keypoint_cost.h"
 #include "klt_contour_tracker/core/pose_parametrization.h"
 #include "klt_contour_tracker/core/search_area.h"
@@ -23,11 +24,6 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kGradientStepPx = 0.5;
 // Huber threshold of the keypoint cue, in units of keypoint_sigma_px (ours).
 constexpr double kKeypointHuberSigmas = 2.0;
-
-double elapsed_ms(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-      .count();
-}
 
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "klt_contour_tracker/core/elapsed.h"
 #include "klt_contour_tracker/core/metrics.h"
 
 namespace kct {
@@ -52,8 +53,7 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
   const auto startup = std::chrono::steady_clock::now();
   TrackingSession session(std::move(mesh), params, options.quality);
   session.set_camera(run.camera);
-  run.startup_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - startup).count();
+  run.startup_ms = elapsed_ms(startup);
   session.initialize(sequence.poses.front());
   Pose last = sequence.poses.front();
   for (std::size_t i = 0; i < frames; ++i) {

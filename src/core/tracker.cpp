@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "klt_contour_tracker/core/elapsed.h"
 #include "klt_contour_tracker/core/motion_model.h"
 #include "klt_contour_tracker/core/motion_prior_cost.h"
 #include "klt_contour_tracker/core/plausibility.h"
@@ -179,8 +180,7 @@ double Tracker::detect_keypoints(const cv::Mat& gray, TrackResult& result,
   const auto start = std::chrono::steady_clock::now();
   keypoints_.detect(gray, pose_i1_, camera_, same_frame_as_track);
   frames_since_detection_ = 0;
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = elapsed_ms(start);
   result.times.keypoint_detection_ms += ms;
   return ms;
 }
@@ -222,8 +222,7 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
     TrackResult invalid;
     invalid.status = TrackStatus::kInvalidInput;
     invalid.message = message;
-    invalid.frame_time_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    invalid.frame_time_ms = elapsed_ms(start);
     return std::vector<TrackResult>(around.size(), invalid);
   }
   // The frame is converted once for every hypothesis; the search box is widened once.
@@ -269,8 +268,7 @@ void Tracker::adopt(const Frame& frame, TrackResult& result) {
   keypoints_.clear();
   detect_keypoints(to_gray(frame.image), result);
   state_ = State::kTracking;
-  result.frame_time_ms +=
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  result.frame_time_ms += elapsed_ms(start);
 }
 
 TrackResult Tracker::reacquire(const Frame& frame, const Pose& around, double search_scale) {
@@ -283,8 +281,7 @@ TrackResult Tracker::track(const Frame& frame) {
   const auto start = std::chrono::steady_clock::now();
   TrackResult result;
   auto finish = [&]() {
-    result.frame_time_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    result.frame_time_ms = elapsed_ms(start);
     return result;
   };
   result.message = check_frame(frame);

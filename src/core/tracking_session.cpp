@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "klt_contour_tracker/core/elapsed.h"
+
 namespace kct {
 namespace {
 
@@ -22,8 +24,13 @@ constexpr double kAgreementDeg = 5.0;
 /// than this many diameters from the held one is not considered.
 constexpr double kRotationCheckMaxShiftDiameters = 0.2;
 
-double elapsed_ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+/// The colour evidence of a scored pose.
+ColorEvidence evidence_of(const SearchCandidate& scored) {
+  ColorEvidence evidence;
+  evidence.valid = true;
+  evidence.contrast = scored.contrast;
+  evidence.visible_fraction = scored.visible_fraction;
+  return evidence;
 }
 
 /// `pose` turned by +-angle_rad about each camera axis through the object's centre.
@@ -176,7 +183,7 @@ bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, Sessio
   if (relocalizer_->keyframes() == 0) return false;
   const auto start = std::chrono::steady_clock::now();
   const Relocalization found = relocalizer_->locate(gray, tracker_->camera());
-  spent_ms = elapsed_ms_since(start);
+  spent_ms = elapsed_ms(start);
   if (!found.found) return false;
   adopt_relocalized(frame, found.object_to_camera, spent_ms, result);
   return true;
@@ -205,7 +212,7 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   const auto start = std::chrono::steady_clock::now();
   const Relocalization found =
       relocalizer_->locate(gray, camera, relocalizer_->region_around(held, camera, kRegionMargin));
-  result.frame.frame_time_ms += elapsed_ms_since(start);
+  result.frame.frame_time_ms += elapsed_ms(start);
   if (!found.found) return;
   const Eigen::Vector3d& center = tracker_->center_object();
   const double moved_m = ((found.object_to_camera * center) - (held * center)).norm();
@@ -247,18 +254,21 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
         scored[i].contrast >= scored[0].contrast + params_.rotation_check_margin * monitor_.color_level() &&
         scored[i].contrast > scored[best].contrast)
       best = i;
-  const double elapsed_ms = elapsed_ms_since(start);
+  const double check_ms = elapsed_ms(start);
   // The same turn must win on two consecutive frames: a single win is often colour noise.
   const int winner = static_cast<int>(best) - 1;
   const bool confirmed = winner >= 0 && winner == rotation_check_winner_;
   rotation_check_winner_ = winner;
+  // The kept pose's colours are scored already (use_colors takes them).
   if (!confirmed) {
-    result.frame.frame_time_ms += elapsed_ms;
+    result.color = evidence_of(scored[0]);
+    result.frame.frame_time_ms += check_ms;
     return;
   }
+  result.color = evidence_of(scored[best]);
   rotation_check_winner_ = -1;
   TrackResult chosen = refined[best - 1];
-  chosen.frame_time_ms = held.frame_time_ms + elapsed_ms;
+  chosen.frame_time_ms = held.frame_time_ms + check_ms;
   tracker_->adopt(frame, chosen);
   result.frame = chosen;
   result.rotation_corrected = true;
@@ -284,11 +294,8 @@ void TrackingSession::use_colors(const cv::Mat& bgr, SessionResult& result) {
     frames_since_learning_ = 0;
     return;
   }
-  if (!search_->ready()) return;
-  const SearchCandidate scored = search_->score(bgr, pose, tracker_->camera());
-  result.color.valid = true;
-  result.color.contrast = scored.contrast;
-  result.color.visible_fraction = scored.visible_fraction;
+  if (!search_->ready() || result.color.valid) return;  // valid: scored by check_rotation
+  result.color = evidence_of(search_->score(bgr, pose, tracker_->camera()));
 }
 
 SessionResult TrackingSession::track(const Frame& frame) {
@@ -331,7 +338,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
         result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
     result.frame.frame_time_ms += relocalize_ms;  // a search of the keyframes that found nothing
     if (!gray.empty()) use_features(frame, gray, result);
-    if (!result.reacquiring && !result.relocalized) check_rotation(frame, bgr, result);
+    check_rotation(frame, bgr, result);  // only on tracked frames (kKeypoints, kExtrapolated)
   }
   use_colors(bgr, result);
   ColorLossRule rule;

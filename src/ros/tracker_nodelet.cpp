@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "klt_contour_tracker/core/debug_drawing.h"
+#include "klt_contour_tracker/core/elapsed.h"
 #include "klt_contour_tracker/core/plausibility.h"
 #include "klt_contour_tracker/core/pose_covariance.h"
 #include "klt_contour_tracker/ros/camera_conversion.h"
@@ -22,11 +23,6 @@
 
 namespace klt_contour_tracker {
 namespace {
-
-double elapsed_ms(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 /// Latest image stamp accepted, s (2100-01-01T00:00:00Z; ROS 1 time ends at 2^32 s in 2106).
 constexpr std::uint32_t kLastStampSec = 4102444800u;
@@ -297,7 +293,7 @@ void TrackerNodelet::process_image(const sensor_msgs::ImageConstPtr& image,
     status->tracking_state = kct::to_string(session_->state());
     status->energy_level = session_->monitor().energy_level();
     status->bad_frames = session_->monitor().consecutive_bad_frames();
-    status->frame_time_ms = elapsed_ms(start);
+    status->frame_time_ms = kct::elapsed_ms(start);
     status_pub_.publish(status);
     last_status_ = *status;
     // In double seconds: ros::Time's operator- throws for stamps 2^31 s from now.

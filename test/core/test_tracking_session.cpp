@@ -328,25 +328,12 @@ TEST(TrackingSession, WeakColourPlacementIsTakenWhenTwoFramesAgree) {
   }
 }
 
-}  // namespace
-}  // namespace kct
-
-namespace kct {
-namespace {
-
 /// rotation_check: the red box vanishes for a frame (KLT fails) and comes back at the same place
 /// turned 20 deg about the camera's x axis. Without the check the track settles on a pose 20 deg
 /// off that every cue accepts (reported good); with it a turned hypothesis wins on two
 /// consecutive frames and replaces it. Shown unturned, nothing is replaced.
 TEST(TrackingSession, RotationCheckCorrectsAWrongRotationTheTrackHolds) {
-  const ColourScene scene;
-  const Eigen::Vector3d center_object = scene.mesh->bounding_box_center();
-  const auto turned_by = [&](double deg) {
-    Pose turned = scene.start;
-    turned.linear() = Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitX()) * scene.start.linear();
-    turned.translation() = scene.start * center_object - turned.linear() * center_object;
-    return turned;
-  };
+  const ColourScene scene;  // the box is centred at its origin: test::move turns it in place
   ASSERT_GT(make_preset("realtime").rotation_check_deg, 0.0) << "realtime checks rotations";
   for (const double turn_deg : {0.0, 20.0})
     for (const bool check : {false, true}) {
@@ -360,7 +347,7 @@ TEST(TrackingSession, RotationCheckCorrectsAWrongRotationTheTrackHolds) {
         session.track({test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
       session.track({scene.background.clone(), stamp});
       stamp += 0.033;
-      const Pose truth = turned_by(turn_deg);
+      const Pose truth = test::move(scene.start, turn_deg, Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero());
       int first_corrected = -1, corrections = 0;
       SessionResult r;
       for (int i = 0; i < 8; ++i, stamp += 0.033) {
