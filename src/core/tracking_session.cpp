@@ -23,6 +23,9 @@ constexpr double kAgreementDeg = 5.0;
 /// rotation_check corrects the rotation: a turned hypothesis whose refined centre moved farther
 /// than this many diameters from the held one is not considered.
 constexpr double kRotationCheckMaxShiftDiameters = 0.2;
+/// texture_check: a turn must correlate at least this well with the learned surface colours
+/// (weaker matches are as often a wrong turn as a right one).
+constexpr double kTextureCheckMinCorrelation = 0.5;
 
 /// The colour evidence of a scored pose.
 ColorEvidence evidence_of(const SearchCandidate& scored) {
@@ -71,6 +74,7 @@ void TrackingSession::set_camera(const PinholeCamera& camera) {
   if (params_.color_search && !search_) search_ = std::make_unique<ObjectSearch>(mesh_);
   if (params_.feature_relocalization && !relocalizer_)
     relocalizer_ = std::make_unique<FeatureRelocalizer>(mesh_);
+  if (params_.texture_check_margin > 0.0 && !texture_) texture_ = std::make_unique<SurfaceTexture>(mesh_);
 }
 
 const Tracker& TrackingSession::tracker() const {
@@ -84,6 +88,8 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   monitor_.on_initialized(object_to_camera);
   if (search_) search_->clear();  // a new track may be another scene
   if (relocalizer_) relocalizer_->clear();
+  if (texture_) texture_->clear();
+  texture_check_winner_ = -1;
   frames_since_learning_ = 0;
   initialized_since_last_frame_ = true;
   lost_at_frame_ = -1;
@@ -112,6 +118,10 @@ void TrackingSession::set_params(const TrackerParams& params) {
     search_.reset();
   else if (!search_ && tracker_)
     search_ = std::make_unique<ObjectSearch>(mesh_);
+  if (!(params_.texture_check_margin > 0.0))
+    texture_.reset();
+  else if (!texture_ && tracker_)
+    texture_ = std::make_unique<SurfaceTexture>(mesh_);
 }
 
 void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
@@ -274,6 +284,101 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
   result.rotation_corrected = true;
 }
 
+void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
+  const TrackResult& held = result.frame;
+  if (!texture_ || !texture_->ready() || !search_ || !search_->ready() || bgr.empty() ||
+      !held.refined || monitor_.color_level() < TrackQualityMonitor::kMinColorLevel ||
+      (held.status != TrackStatus::kKeypoints && held.status != TrackStatus::kExtrapolated) ||
+      frames_since_doubt_ > params_.rotation_check_frames)
+    return;
+  const auto start = std::chrono::steady_clock::now();
+  const PinholeCamera& camera = tracker_->camera();
+  const Pose& held_pose = held.object_to_camera;
+  const PreparedFrame prepared = texture_->prepare(bgr, held_pose, camera);
+  const double held_correlation = texture_->agreement(prepared, held_pose, camera).correlation;
+  // Turns about the object's own axes through its centre, k x step for k = 1 .. n - 1.
+  const Eigen::Vector3d& center = tracker_->center_object();
+  const Eigen::Vector3d held_center = held_pose * center;
+  const int steps = static_cast<int>(std::lround(360.0 / params_.texture_check_step_deg));
+  const auto turned = [&](int axis, double angle_rad) {
+    Pose p = held_pose;
+    p.linear() = held_pose.linear() * Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
+    p.translation() = held_center - p.linear() * center;
+    return p;
+  };
+  const double step_rad = 2.0 * M_PI / steps;
+  int winner = -1;
+  double best_correlation =
+      std::max(held_correlation + params_.texture_check_margin, kTextureCheckMinCorrelation);
+  Pose best_pose = held_pose;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int k = 1; k < steps; ++k) {
+      const Pose p = turned(axis, k * step_rad);
+      const TextureAgreement a = texture_->agreement(prepared, p, camera);
+      if (a.points >= SurfaceTexture::kMinPoints && a.correlation >= best_correlation) {
+        best_correlation = a.correlation;
+        winner = axis * steps + k;
+        best_pose = p;
+      }
+    }
+  // The winning turn's angle to a sixth of the step (the outline does not fix a turn about a
+  // symmetry axis, so the refinement will not).
+  if (winner >= 0) {
+    const int axis = winner / steps, k = winner % steps;
+    for (const double offset : {-2.0, -1.0, 1.0, 2.0}) {
+      const Pose p = turned(axis, (k + offset / 6.0) * step_rad);
+      const TextureAgreement a = texture_->agreement(prepared, p, camera);
+      if (a.points >= SurfaceTexture::kMinPoints && a.correlation > best_correlation) {
+        best_correlation = a.correlation;
+        best_pose = p;
+      }
+    }
+  }
+  // The same turn must win on two consecutive frames before it is refined and tried.
+  const bool confirmed = winner >= 0 && winner == texture_check_winner_;
+  texture_check_winner_ = winner;
+  if (!confirmed) {
+    result.frame.frame_time_ms += elapsed_ms(start);
+    return;
+  }
+  texture_check_winner_ = -1;
+  // Two ways the turn may replace the held pose. Refined (contour only), when it still matches
+  // the surface better. Or as it is, when its outline is the held one's (its colour contrast no
+  // lower by more than a tenth of the level): a turn about a symmetry axis, which the refinement
+  // cannot fix and often scrambles; its contour energy is then the held pose's.
+  TrackResult refined = tracker_->refine_hypotheses(frame, {best_pose}, 1.0).front();
+  const std::vector<SearchCandidate> colors =
+      search_->score(bgr, {held_pose, refined.object_to_camera, best_pose}, camera);
+  const double level = monitor_.color_level();
+  const auto kept_place = [&](const Pose& p) {
+    return (p * center - held_center).norm() < kRotationCheckMaxShiftDiameters * tracker_->diameter_m();
+  };
+  const bool refined_better =
+      refined.refined &&
+      texture_->agreement(prepared, refined.object_to_camera, camera).correlation >=
+          std::max(held_correlation + params_.texture_check_margin, kTextureCheckMinCorrelation) &&
+      refined.energy_after >= 0.9 * held.energy_after && kept_place(refined.object_to_camera) &&
+      colors[1].contrast >= params_.color_accept_ratio * level;
+  const bool same_outline = colors[2].contrast >= colors[0].contrast - 0.1 * level &&
+                            colors[2].contrast >= params_.color_accept_ratio * level;
+  const double check_ms = elapsed_ms(start);
+  if (!refined_better && !same_outline) {
+    result.frame.frame_time_ms += check_ms;
+    return;
+  }
+  TrackResult chosen = refined;
+  if (!refined_better) {
+    chosen = held;
+    chosen.status = TrackStatus::kReacquired;
+    chosen.object_to_camera = best_pose;
+  }
+  chosen.frame_time_ms = held.frame_time_ms + check_ms;
+  tracker_->adopt(frame, chosen);
+  result.frame = chosen;
+  result.color = evidence_of(colors[refined_better ? 1 : 2]);
+  result.texture_corrected = true;
+}
+
 void TrackingSession::add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result) {
   if (!result.has_pose()) return;
   const TrackResult& f = result.frame;
@@ -339,8 +444,11 @@ SessionResult TrackingSession::track(const Frame& frame) {
     result.frame.frame_time_ms += relocalize_ms;  // a search of the keyframes that found nothing
     if (!gray.empty()) use_features(frame, gray, result);
     check_rotation(frame, bgr, result);  // only on tracked frames (kKeypoints, kExtrapolated)
+    if (!result.rotation_corrected) check_texture(frame, bgr, result);
   }
   use_colors(bgr, result);
+  if (texture_ && !bgr.empty() && result.frame.status == TrackStatus::kInitialized)
+    texture_->learn(bgr, result.frame.object_to_camera, tracker_->camera());
   ColorLossRule rule;
   rule.lost_ratio = params_.color_lost_ratio;
   rule.contour_veto_ratio = params_.color_contour_veto_ratio;

@@ -40,6 +40,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.motion_prior_weight, 0.0);
   EXPECT_DOUBLE_EQ(p.region_weight, 0.0);
   EXPECT_DOUBLE_EQ(p.rotation_check_deg, 0.0);
+  EXPECT_DOUBLE_EQ(p.texture_check_margin, 0.0);
 }
 
 TEST(TrackerParams, CueFieldsAreValidated) {
@@ -62,6 +63,8 @@ TEST(TrackerParams, CueFieldsAreValidated) {
   EXPECT_TRUE(rejects("rotation_check_deg", "-5"));
   EXPECT_TRUE(rejects("rotation_check_frames", "0"));
   EXPECT_TRUE(rejects("rotation_check_margin", "-0.1"));
+  EXPECT_TRUE(rejects("texture_check_margin", "-0.1"));
+  EXPECT_TRUE(rejects("texture_check_step_deg", "0"));
   EXPECT_TRUE(rejects("region_line_half_length_px", "1"));
   EXPECT_TRUE(rejects("region_line_spacing_px", "0"));
   EXPECT_TRUE(rejects("region_band_px", "0"));
@@ -114,7 +117,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 76u);
+  EXPECT_EQ(fields.size(), 78u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

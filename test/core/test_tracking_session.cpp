@@ -376,5 +376,60 @@ TEST(TrackingSession, RotationCheckCorrectsAWrongRotationTheTrackHolds) {
     }
 }
 
+/// texture_check: a textured cube vanishes for a frame (KLT fails) and comes back at the same
+/// place turned 90 deg about its own z axis: the same outline and colours, another face
+/// pattern. Without the check the track holds the unturned pose (reported good); with it the
+/// learned surface colours find the turn on two consecutive frames and it replaces the pose.
+/// Shown unturned, nothing is replaced.
+TEST(TrackingSession, TextureCheckFindsATurnAboutTheObjectsAxis) {
+  const auto cube = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1));
+  const Renderer renderer(cube);
+  const PinholeCamera camera = test::make_camera();
+  const cv::Mat background = test::make_background(camera.size(), 5) * 0.5 + cv::Scalar(90, 70, 40);
+  const Pose start = test::make_pose(0.45);
+  ASSERT_GT(make_preset("realtime").texture_check_margin, 0.0) << "realtime checks the texture";
+  for (const double turn_deg : {0.0, 90.0})
+    for (const bool check : {false, true}) {
+      TrackerParams params = quick_realtime();
+      if (!check) params.texture_check_margin = 0.0;
+      TrackingSession session(cube, params);
+      session.set_camera(camera);
+      session.initialize(start);
+      double stamp = 0.0;
+      for (int i = 0; i < 8; ++i, stamp += 0.033)
+        session.track({test::render_frame(renderer, camera, start, background, 1.5, i), stamp});
+      session.track({background.clone(), stamp});
+      stamp += 0.033;
+      Pose truth = start;
+      truth.linear() = start.linear() * Eigen::AngleAxisd(turn_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      int first_corrected = -1, corrections = 0;
+      SessionResult r;
+      for (int i = 0; i < 8; ++i, stamp += 0.033) {
+        r = session.track({test::render_frame(renderer, camera, truth, background, 1.5, 20 + i), stamp});
+        if (r.texture_corrected && first_corrected < 0) first_corrected = i;
+        corrections += r.texture_corrected ? 1 : 0;
+      }
+      const std::string what = "turn " + std::to_string(turn_deg) + (check ? " with" : " without") + " the check";
+      ASSERT_EQ(r.state, TrackState::kTracking) << what;
+      EXPECT_TRUE(r.good) << what;
+      // Tolerances for a 10 cm cube at 0.45 m: 4 deg (measured 2.7 unturned, with or without the
+      // check: the cube's outline fixes its rotation loosely) and 5 mm when right; the wrong hold
+      // is the turn itself.
+      if (turn_deg == 0.0 || check) {
+        EXPECT_LT(rotation_error_deg(r.frame.object_to_camera, truth), 4.0) << what;
+        EXPECT_LT(translation_error(r.frame.object_to_camera, truth), 0.005) << what;
+      } else {
+        EXPECT_GT(rotation_error_deg(r.frame.object_to_camera, truth), 45.0)
+            << "the turned cube was found without the check: the test shows nothing";
+      }
+      if (turn_deg == 0.0 || !check) {
+        EXPECT_EQ(corrections, 0) << what;
+      } else {
+        EXPECT_GE(first_corrected, 1) << "corrected on the first frame: not confirmed (-1: never)";
+        EXPECT_EQ(corrections, 1) << what;
+      }
+    }
+}
+
 }  // namespace
 }  // namespace kct

@@ -138,6 +138,18 @@ struct TrackerParams {
   double rotation_check_deg = 0.0;
   int rotation_check_frames = 5;       ///< see rotation_check_deg
   double rotation_check_margin = 0.1;  ///< see rotation_check_deg
+  /// ours (tracking session, 0 = off; needs color_search): the object's surface colours are
+  /// learned at the initial pose (SurfaceTexture; only when they vary enough: a uniformly
+  /// coloured object has no pattern). In rotation_check's window, the held pose is also turned
+  /// about each of the object's own axes through its centre in steps of texture_check_step_deg;
+  /// a turn whose colours correlate with the learned ones better than the held pose's by
+  /// texture_check_margin wins. When the same turn wins on two consecutive frames it is refined
+  /// (contour only) and replaces the held pose if it still correlates better by the margin, its
+  /// contour energy is at least 0.9x the held one's, its centre stayed within 0.2 diameters and
+  /// its colour contrast passes color_accept_ratio. It catches turns about a symmetry axis (a
+  /// can) that no outline or colour histogram can see.
+  double texture_check_margin = 0.0;
+  double texture_check_step_deg = 30.0;  ///< see texture_check_margin
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline

@@ -15,6 +15,7 @@
 #include "klt_contour_tracker/core/feature_relocalizer.h"
 #include "klt_contour_tracker/core/object_search.h"
 #include "klt_contour_tracker/core/pose.h"
+#include "klt_contour_tracker/core/surface_texture.h"
 #include "klt_contour_tracker/core/track_quality.h"
 #include "klt_contour_tracker/core/tracker.h"
 #include "klt_contour_tracker/core/tracker_params.h"
@@ -36,6 +37,9 @@ struct SessionResult {
   bool relocalized = false;
   /// rotation_check replaced the tracked pose by a turned one that the colours fit better.
   bool rotation_corrected = false;
+  /// texture_check replaced the tracked pose by one turned about an object axis whose surface
+  /// colours match the learned ones better.
+  bool texture_corrected = false;
   ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
   bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
   bool restarted = false;    ///< ... and the session restarted from restart_pose()
@@ -122,6 +126,10 @@ class TrackingSession {
   /// refined; one whose colour contrast beats the held pose's by the margin (and whose contour
   /// energy is no lower) replaces it and the keypoints are anchored afresh.
   void check_rotation(const Frame& frame, const cv::Mat& bgr, SessionResult& result);
+  /// texture_check: the tracked pose turned about the object's own axes; a turn whose surface
+  /// colours match the learned ones better by the margin, on two consecutive frames, is refined
+  /// and replaces the held pose (see TrackerParams::texture_check_margin).
+  void check_texture(const Frame& frame, const cv::Mat& bgr, SessionResult& result);
   /// Adds a keyframe on the initial frame and on confident frames seen from a new viewpoint.
   void add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result);
   /// The colour model's evidence for `result` and its learning on good frames (color_search).
@@ -139,6 +147,9 @@ class TrackingSession {
   bool features_confirm_ = false;
   int frames_since_learning_ = 0;
   int rotation_check_winner_ = -1;  ///< the turn that won rotation_check on the last frame
+  /// The surface colours learned at the initial pose; null unless texture_check_margin > 0.
+  std::unique_ptr<SurfaceTexture> texture_;
+  int texture_check_winner_ = -1;  ///< the turn that won texture_check on the last frame
   int frames_since_doubt_ = 1000;  ///< frames since KLT last failed or a re-acquisition
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
