@@ -135,13 +135,23 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       monitor_.color_level() >= TrackQualityMonitor::kMinColorLevel) {
     // Hypotheses: the best colour placements, each at the last good rotation and turned by
     // +-color_search_rotation_deg about the camera axes (the object may have turned while it
-    // was hidden), plus the last good pose; each refined, the best colour contrast wins.
+    // was hidden), plus the last good pose and the last frame's; each refined, the best colour
+    // contrast wins.
+    // Hypotheses: the best colour placements, each at the last good rotation and turned by
+    // +-color_search_rotation_deg about the camera axes (the object may have turned while it
+    // was hidden), plus the last good pose and the last frame's; each refined, the best colour
+    // contrast wins.
     const PinholeCamera& camera = tracker_->camera();
     std::vector<SearchCandidate> found = search_->search(bgr, last_good, camera);
     if (static_cast<int>(found.size()) > params_.color_search_placements)
       found.resize(static_cast<std::size_t>(params_.color_search_placements));
     std::vector<Pose> hypotheses{last_good};
     const Eigen::Vector3d& center_object = tracker_->center_object();
+    // The pose the last frame ended at (a placement taken while lost, or where the pipeline
+    // went): the object moves on between frames, so last frame's find is this frame's best start.
+    if (((tracker_->last_pose() * center_object) - (last_good * center_object)).norm() >
+        0.05 * tracker_->diameter_m())
+      hypotheses.push_back(tracker_->last_pose());
     const double angle = params_.color_search_rotation_deg * M_PI / 180.0;
     for (const SearchCandidate& candidate : found) {
       const Pose& placed = candidate.object_to_camera;
@@ -177,7 +187,9 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       unconfirmed_.reset();
     }
     if (best_contrast >= params_.color_accept_ratio * monitor_.color_level() || confirmed) {
-      unconfirmed_.reset();
+      // The taken pose confirms the next frame's best when it is at the same place: while the
+      // track stays lost, a confirmed placement is not asked to wait a frame again.
+      unconfirmed_ = best.object_to_camera;
       searched = true;
       best.frame_time_ms = time_ms;
       tracker_->adopt(frame, best);

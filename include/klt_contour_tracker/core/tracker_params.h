@@ -149,7 +149,7 @@ struct TrackerParams {
   /// its colour contrast passes color_accept_ratio. It catches turns about a symmetry axis (a
   /// can) that no outline or colour histogram can see.
   double texture_check_margin = 0.0;
-  double texture_check_step_deg = 30.0;  ///< see texture_check_margin
+  double texture_check_step_deg = 10.0;  ///< see texture_check_margin
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline
