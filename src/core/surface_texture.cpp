@@ -21,6 +21,10 @@ constexpr double kMinFacingCosine = 0.2;
 /// The surface counts as textured when the median point's band-passed colour is at least this
 /// far from zero (grey levels, root mean square over the channels).
 constexpr double kMinBandMedian = 3.0;
+/// The surface has a colour pattern when its points' chromaticity spreads by at least this
+/// (root mean square distance from the mean; benchmark objects: textured can and chest
+/// 0.20-0.48, uniformly orange toy 0.08-0.10, grey castle 0.01).
+constexpr double kMinChromaStd = 0.15;
 
 /// Bilinear value of a CV_32FC3 image at a sub-pixel point at least 1 px inside it.
 Eigen::Vector3f sample(const cv::Mat& image, double x, double y) {
@@ -77,13 +81,13 @@ PreparedFrame SurfaceTexture::prepare(const cv::Mat& bgr, const Pose& object_to_
   cv::GaussianBlur(work, fine, cv::Size(), fine_sigma, fine_sigma, cv::BORDER_REPLICATE);
   cv::GaussianBlur(work, coarse, cv::Size(), coarse_sigma, coarse_sigma, cv::BORDER_REPLICATE);
   prepared.band = fine - coarse;
+  prepared.fine = fine;
   return prepared;
 }
 
 void SurfaceTexture::learn(const cv::Mat& bgr, const Pose& object_to_camera,
                            const PinholeCamera& camera, int max_points) {
   clear();
-  textured_ = false;
   if (bgr.type() != CV_8UC3 || bgr.size() != camera.size() || max_points <= 0) return;
   RenderOptions options;
   options.draw_color = false;
@@ -101,6 +105,7 @@ void SurfaceTexture::learn(const cv::Mat& bgr, const Pose& object_to_camera,
   if (area == 0) return;
   const int step = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(area) / max_points)));
   const PreparedFrame prepared = prepare(bgr, object_to_camera, camera);
+  std::vector<Eigen::Vector3f> chroma;
   if (prepared.band.empty()) return;
   for (int v = box.y; v < box.y + box.height; v += step)
     for (int u = box.x; u < box.x + box.width; u += step) {
@@ -120,6 +125,10 @@ void SurfaceTexture::learn(const cv::Mat& bgr, const Pose& object_to_camera,
       points_object_.push_back(point_object);
       normals_object_.push_back(normal);
       colors_.push_back(sample(prepared.band, x, y));
+      // Chromaticity: the colour's departure from grey relative to its brightness (+10 grey
+      // levels keeps dark points from dominating), which shading does not change.
+      const Eigen::Vector3f c = sample(prepared.fine, x, y);
+      chroma.push_back((c.array() - c.mean()).matrix() / (c.mean() + 10.0f));
     }
   if (size() < kMinPoints) return;
   // The typical point's band-passed colour, not the spread over all points: the shading steps at
@@ -129,6 +138,14 @@ void SurfaceTexture::learn(const cv::Mat& bgr, const Pose& object_to_camera,
   std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2, magnitudes.end());
   const double median = magnitudes[magnitudes.size() / 2];
   textured_ = median >= kMinBandMedian;
+  // The spread of the chromaticity over the surface: a uniformly coloured object shaded by the
+  // light keeps its chromaticity (only specular highlights and shadows move it a little).
+  Eigen::Vector3f mean_chroma = Eigen::Vector3f::Zero();
+  for (const Eigen::Vector3f& c : chroma) mean_chroma += c;
+  mean_chroma /= static_cast<float>(chroma.size());
+  double chroma_variance = 0.0;
+  for (const Eigen::Vector3f& c : chroma) chroma_variance += (c - mean_chroma).squaredNorm();
+  color_pattern_ = textured_ && std::sqrt(chroma_variance / chroma.size()) >= kMinChromaStd;
 }
 
 TextureAgreement SurfaceTexture::agreement(const PreparedFrame& prepared, const Pose& object_to_camera,

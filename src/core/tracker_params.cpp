@@ -41,7 +41,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(feature_relocalization), KCT_FIELD(relocalization_override_inliers),
       KCT_FIELD(rotation_check_deg), KCT_FIELD(rotation_check_frames),
       KCT_FIELD(rotation_check_margin), KCT_FIELD(texture_check_margin),
-      KCT_FIELD(texture_check_step_deg),
+      KCT_FIELD(texture_check_step_deg), KCT_FIELD(texture_check_every_frame),
       KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
       KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
       KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
@@ -245,6 +245,7 @@ TrackerParams make_preset(const std::string& name) {
     // mean AUC; of 12 corrections 9 lowered the rotation error (136.7 -> 3.2, 48.2 -> 2.6,
     // 24.7 -> 5.8 deg ...), one raised it (castle, 26.7 -> 32.5), two were on lost tracks.
     params.texture_check_margin = 0.2;
+    params.texture_check_every_frame = true;
     return params;
   }
   if (name == "klt_only") {

@@ -301,7 +301,8 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   if (!texture_ || !texture_->ready() || !search_ || !search_->ready() || bgr.empty() ||
       !held.refined || monitor_.color_level() < TrackQualityMonitor::kMinColorLevel ||
       (held.status != TrackStatus::kKeypoints && held.status != TrackStatus::kExtrapolated) ||
-      frames_since_doubt_ > params_.rotation_check_frames)
+      (frames_since_doubt_ > params_.rotation_check_frames &&
+       !(params_.texture_check_every_frame && texture_->has_color_pattern())))
     return;
   const auto start = std::chrono::steady_clock::now();
   const PinholeCamera& camera = tracker_->camera();

@@ -55,6 +55,24 @@ TEST(SurfaceTexture, TellsTheRightPoseFromTheObjectTurnedAboutItsAxis) {
   EXPECT_LT(texture.agreement(prepared, scene.start, scene.camera).correlation, 0.4);
 }
 
+TEST(SurfaceTexture, AColourPatternIsToldFromABrightnessPattern) {
+  TextureScene scene;
+  SurfaceTexture texture(scene.mesh);
+  texture.learn(scene.frame(scene.start, 1), scene.start, scene.camera);
+  ASSERT_TRUE(texture.ready());
+  EXPECT_TRUE(texture.has_color_pattern()) << "random colours";
+  // The same texture in grey: a pattern, but not in the colours.
+  auto grey_box = std::make_shared<Mesh>(*scene.mesh);
+  cv::cvtColor(grey_box->texture, grey_box->texture, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey_box->texture, grey_box->texture, cv::COLOR_GRAY2BGR);
+  const Renderer renderer(grey_box);
+  SurfaceTexture grey_texture(grey_box);
+  grey_texture.learn(test::render_frame(renderer, scene.camera, scene.start, scene.background, 2.0, 1),
+                     scene.start, scene.camera);
+  EXPECT_TRUE(grey_texture.ready());
+  EXPECT_FALSE(grey_texture.has_color_pattern());
+}
+
 TEST(SurfaceTexture, AnUntexturedObjectOrAMissingOneIsNotUsed) {
   TextureScene scene;
   SurfaceTexture texture(scene.mesh);
@@ -75,6 +93,7 @@ TEST(SurfaceTexture, AnUntexturedObjectOrAMissingOneIsNotUsed) {
   plain_texture.learn(test::render_frame(renderer, scene.camera, scene.start, scene.background, 2.0, 1),
                       scene.start, scene.camera);
   EXPECT_FALSE(plain_texture.ready());
+  EXPECT_FALSE(plain_texture.has_color_pattern());
 }
 
 }  // namespace

@@ -41,6 +41,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.region_weight, 0.0);
   EXPECT_DOUBLE_EQ(p.rotation_check_deg, 0.0);
   EXPECT_DOUBLE_EQ(p.texture_check_margin, 0.0);
+  EXPECT_FALSE(p.texture_check_every_frame);
 }
 
 TEST(TrackerParams, CueFieldsAreValidated) {
@@ -117,7 +118,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 78u);
+  EXPECT_EQ(fields.size(), 79u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

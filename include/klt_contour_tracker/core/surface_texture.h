@@ -31,6 +31,7 @@ struct TextureAgreement {
 /// A frame's neighbourhood of the object, band-passed (see SurfaceTexture::prepare()).
 struct PreparedFrame {
   cv::Mat band;   ///< CV_32FC3: fine minus coarse smoothing, at `scale` of the frame
+  cv::Mat fine;   ///< CV_32FC3: the fine smoothing alone (colours, for learn()'s chromaticity)
   cv::Rect roi;   ///< the frame's pixels it covers
   double scale = 1.0;  ///< band pixels per frame pixel
 };
@@ -48,10 +49,20 @@ class SurfaceTexture {
   /// outline (where the background blends in). Replaces what was learned before.
   void learn(const cv::Mat& bgr, const Pose& object_to_camera, const PinholeCamera& camera,
              int max_points = 400);
-  void clear() { points_object_.clear(); normals_object_.clear(); colors_.clear(); }
-  /// Learned, and the colours vary enough over the surface to tell poses apart (a uniformly
-  /// coloured object has no pattern to compare).
+  void clear() {
+    points_object_.clear();
+    normals_object_.clear();
+    colors_.clear();
+    textured_ = color_pattern_ = false;
+  }
+  /// Learned, and the band-passed colours of the typical point are far enough from zero to
+  /// tell poses apart: a flat-shaded uniform object has a pattern only along its creases.
+  /// Smooth shading and the creases of a many-faced model still pass (the benchmark's orange
+  /// toy and grey castle do).
   bool ready() const { return textured_; }
+  /// ready(), and the pattern is in the colours' chromaticity, not only in their brightness:
+  /// printed or painted colours, which shading and light do not make. A stronger cue.
+  bool has_color_pattern() const { return color_pattern_; }
   int size() const { return static_cast<int>(points_object_.size()); }
 
   /// The object's neighbourhood in `bgr` (a disc of one diameter around its centre at
@@ -75,6 +86,7 @@ class SurfaceTexture {
   std::vector<Eigen::Vector3d> normals_object_;  ///< unit, outward, object frame
   std::vector<Eigen::Vector3f> colors_;          ///< B, G, R in [0, 255]
   bool textured_ = false;
+  bool color_pattern_ = false;
 };
 
 }  // namespace kct
