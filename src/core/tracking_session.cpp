@@ -26,6 +26,11 @@ constexpr double kRotationCheckMaxShiftDiameters = 0.2;
 /// texture_check: a turn must correlate at least this well with the learned surface colours
 /// (weaker matches are as often a wrong turn as a right one).
 constexpr double kTextureCheckMinCorrelation = 0.5;
+/// texture_check: a refined turn keeps at least this share of the held pose's contour energy.
+constexpr double kTextureCheckMinEnergyRatio = 0.9;
+/// texture_check: an unrefined turn has the held pose's outline when its colour contrast is
+/// lower by less than this x the contrast level.
+constexpr double kSameOutlineContrastTolerance = 0.1;
 
 /// The colour evidence of a scored pose.
 ColorEvidence evidence_of(const SearchCandidate& scored) {
@@ -356,9 +361,9 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   }
   texture_check_winner_ = -1;
   // Two ways the turn may replace the held pose. Refined (contour only), when it still matches
-  // the surface better. Or as it is, when its outline is the held one's (its colour contrast no
-  // lower by more than a tenth of the level): a turn about a symmetry axis, which the refinement
-  // cannot fix and often scrambles; its contour energy is then the held pose's.
+  // the surface better. Or as it is, when its outline is the held one's (its colour contrast
+  // nearly the held pose's): a turn about a symmetry axis, which the refinement cannot fix and
+  // often scrambles; its contour energy is then the held pose's.
   TrackResult refined = tracker_->refine_hypotheses(frame, {best_pose}, 1.0).front();
   const std::vector<SearchCandidate> colors =
       search_->score(bgr, {held_pose, refined.object_to_camera, best_pose}, camera);
@@ -370,9 +375,10 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
       refined.refined &&
       texture_->agreement(prepared, refined.object_to_camera, camera).correlation >=
           std::max(held_correlation + params_.texture_check_margin, kTextureCheckMinCorrelation) &&
-      refined.energy_after >= 0.9 * held.energy_after && kept_place(refined.object_to_camera) &&
+      refined.energy_after >= kTextureCheckMinEnergyRatio * held.energy_after &&
+      kept_place(refined.object_to_camera) &&
       colors[1].contrast >= params_.color_accept_ratio * level;
-  const bool same_outline = colors[2].contrast >= colors[0].contrast - 0.1 * level &&
+  const bool same_outline = colors[2].contrast >= colors[0].contrast - kSameOutlineContrastTolerance * level &&
                             colors[2].contrast >= params_.color_accept_ratio * level;
   const double check_ms = elapsed_ms(start);
   if (!refined_better && !same_outline) {
