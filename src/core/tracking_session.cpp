@@ -142,10 +142,6 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     // +-color_search_rotation_deg about the camera axes (the object may have turned while it
     // was hidden), plus the last good pose and the last frame's; each refined, the best colour
     // contrast wins.
-    // Hypotheses: the best colour placements, each at the last good rotation and turned by
-    // +-color_search_rotation_deg about the camera axes (the object may have turned while it
-    // was hidden), plus the last good pose and the last frame's; each refined, the best colour
-    // contrast wins.
     const PinholeCamera& camera = tracker_->camera();
     std::vector<SearchCandidate> found = search_->search(bgr, last_good, camera);
     if (static_cast<int>(found.size()) > params_.color_search_placements)
@@ -257,11 +253,15 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   adopt_relocalized(frame, found.object_to_camera, result.frame.frame_time_ms, result);
 }
 
+bool TrackingSession::checkable(const TrackResult& held, const cv::Mat& bgr) const {
+  return search_ && search_->ready() && !bgr.empty() && held.refined &&
+         monitor_.color_level() >= TrackQualityMonitor::kMinColorLevel &&
+         (held.status == TrackStatus::kKeypoints || held.status == TrackStatus::kExtrapolated);
+}
+
 void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
   const TrackResult& held = result.frame;
-  if (!(params_.rotation_check_deg > 0.0) || !search_ || !search_->ready() || bgr.empty() ||
-      !held.refined || monitor_.color_level() < TrackQualityMonitor::kMinColorLevel ||
-      (held.status != TrackStatus::kKeypoints && held.status != TrackStatus::kExtrapolated) ||
+  if (!(params_.rotation_check_deg > 0.0) || !checkable(held, bgr) ||
       frames_since_doubt_ > params_.rotation_check_frames)
     return;
   const auto start = std::chrono::steady_clock::now();
@@ -303,9 +303,7 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
 
 void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
   const TrackResult& held = result.frame;
-  if (!texture_ || !texture_->ready() || !search_ || !search_->ready() || bgr.empty() ||
-      !held.refined || monitor_.color_level() < TrackQualityMonitor::kMinColorLevel ||
-      (held.status != TrackStatus::kKeypoints && held.status != TrackStatus::kExtrapolated) ||
+  if (!texture_ || !texture_->ready() || !checkable(held, bgr) ||
       (frames_since_doubt_ > params_.rotation_check_frames &&
        !(params_.texture_check_every_frame && texture_->has_color_pattern())))
     return;

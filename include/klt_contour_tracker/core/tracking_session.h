@@ -122,6 +122,9 @@ class TrackingSession {
   /// (kReacquired, relocalized) with `frame_time_ms` so far.
   void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, double frame_time_ms,
                          SessionResult& result);
+  /// rotation_check's and texture_check's common ground: the colour model is ready, the frame
+  /// is in colour and `held` is a refined tracked pose (kKeypoints, kExtrapolated).
+  bool checkable(const TrackResult& held, const cv::Mat& bgr) const;
   /// rotation_check: the tracked pose turned by +-rotation_check_deg about camera axes, each
   /// refined; one whose colour contrast beats the held pose's by the margin (and whose contour
   /// energy is no lower) replaces it and the keypoints are anchored afresh.
