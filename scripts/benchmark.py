@@ -344,6 +344,29 @@ def speed_table(rows, configs, key_rows):
     return L
 
 
+def tail_table(rows, configs, key_rows):
+    """The slow frames: per object, the median over its sequences of each sequence's 90th
+    percentile frame time, and the slowest frame of any of its sequences, ms. Only configurations
+    whose results carry them (results from before p90_ms/max_ms was written show none)."""
+    tailed = [c[0] for c in configs if any("p90_ms" in r for r in rows if r["preset"] == c[0])]
+    if not tailed:
+        return []
+    L = ["Slow frames: median over the sequences of each sequence's 90th-percentile `track()` time, "
+         "and in brackets the slowest frame of all the object's sequences, ms (a frame above the camera "
+         "period is a frame the nodelet's queue has to absorb).\n",
+         "| object | " + " | ".join(tailed) + " |", "|---|" + "---|" * len(tailed)]
+    for name, rr in key_rows:
+        cells = []
+        for p in tailed:
+            mine = [r for r in rr if r["preset"] == p and "p90_ms" in r]
+            cells.append("%s (%s)" % (fmt(median([r["p90_ms"] for r in mine]), 1),
+                                      fmt(max([r["max_ms"] for r in mine]) if mine else None, 0)))
+        if rr:
+            L.append("| %s | %s |" % (name, " | ".join(cells)))
+    L.append("")
+    return L
+
+
 STAGES = [("klt", "KLT"), ("pnp", "PnP"), ("keypoint_detection", "keypoint detection"),
           ("image", "image (pyramid, gradients)"), ("contour_extraction", "contour extraction"),
           ("energy", "energy (cues)"), ("optimizer", "optimizer")]
@@ -573,6 +596,7 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
     L.append("Median of the per-sequence median `track()` time per frame (first frame excluded), ms.\n")
     L += speed_table(rows, configs, [(o, sel(object=o)) for o in objects])
     L.append("")
+    L += tail_table(rows, [c for c in configs if c[0] in DEFAULT_PRESETS], [(o, sel(object=o)) for o in objects])
     L += stage_table(rows, configs, [(o, sel(object=o)) for o in objects])
     for name in os.listdir(docs_dir):
         if name.startswith(set_name + "_") and name.endswith(".png"):
@@ -900,6 +924,7 @@ def run_opt(args, configs, runner, data, docs_dir, tmp):
     L.append("Median of the per-sequence median tracking time per frame (first frame excluded), ms.\n")
     L += speed_table(rows, configs, [(o, sel(object=o)) for o in objects])
     L.append("")
+    L += tail_table(rows, [c for c in configs if c[0] in DEFAULT_PRESETS], [(o, sel(object=o)) for o in objects])
 
     def growth(p):
         vga = [(r0["faces"], median([r["median_ms"] for r in sel(preset=p, object=o)]))

@@ -1,6 +1,7 @@
 #include "klt_contour_tracker/core/metrics.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace kct {
@@ -50,6 +51,15 @@ double median(std::vector<double> values) {
   if (values.size() % 2) return values[mid];
   const double upper = values[mid];
   return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
+}
+
+double percentile(std::vector<double> values, double percent) {
+  if (values.empty()) return 0.0;
+  const double clamped = std::min(100.0, std::max(0.0, percent));
+  // Nearest rank: ceil(p/100 * n), 1-based; at least the first value.
+  const size_t rank = std::max<size_t>(1, static_cast<size_t>(std::ceil(clamped / 100.0 * values.size())));
+  std::nth_element(values.begin(), values.begin() + (rank - 1), values.end());
+  return values[rank - 1];
 }
 
 }  // namespace kct

@@ -223,7 +223,9 @@ int main(int argc, char** argv) {
          << ",\n  \"reacquisitions\": " << stats.reacquisitions
          << ",\n  \"frames_to_reacquire\": [" << join(stats.frames_to_reacquire) << "]"
          << ",\n  \"startup_ms\": " << run.startup_ms
-         << ",\n  \"median_ms\": " << kct::median(run.frame_ms) << ",\n  \"stage_median_ms\": {";
+         << ",\n  \"median_ms\": " << kct::median(run.frame_ms)
+         << ",\n  \"p90_ms\": " << kct::percentile(run.frame_ms, 90)
+         << ",\n  \"max_ms\": " << kct::percentile(run.frame_ms, 100) << ",\n  \"stage_median_ms\": {";
     for (size_t k = 0; k < stages.size(); ++k)
       json << (k ? ", " : "") << "\"" << stages[k].first << "\": " << kct::median(stage_ms[k]);
     json << "}";
@@ -236,6 +238,8 @@ int main(int argc, char** argv) {
                 stats.frames_to_reacquire.empty() ? "-" : join(stats.frames_to_reacquire).c_str());
     std::printf("startup_ms        %.1f\n", run.startup_ms);
     std::printf("median_ms         %.2f\n", kct::median(run.frame_ms));
+    std::printf("p90_ms            %.2f\n", kct::percentile(run.frame_ms, 90));
+    std::printf("max_ms            %.2f\n", kct::percentile(run.frame_ms, 100));
 
     // Score the frames that have ground truth (pose.txt may hold more lines than images).
     int exit_code = 0;

@@ -70,6 +70,17 @@ TEST(Metrics, Median) {
   EXPECT_DOUBLE_EQ(median({}), 0.0);
 }
 
+TEST(Metrics, NearestRankPercentile) {
+  const std::vector<double> ten = {10, 1, 9, 2, 8, 3, 7, 4, 6, 5};
+  EXPECT_DOUBLE_EQ(percentile(ten, 90), 9.0);
+  EXPECT_DOUBLE_EQ(percentile(ten, 91), 10.0);
+  EXPECT_DOUBLE_EQ(percentile(ten, 100), 10.0);
+  EXPECT_DOUBLE_EQ(percentile(ten, 50), 5.0);
+  EXPECT_DOUBLE_EQ(percentile(ten, 0), 1.0);
+  EXPECT_DOUBLE_EQ(percentile({42}, 90), 42.0);
+  EXPECT_DOUBLE_EQ(percentile({}, 90), 0.0);
+}
+
 TEST(Pose, ExtrapolationRepeatsTheLastMotion) {
   Pose p0 = Pose::Identity();
   p0.translation() = Eigen::Vector3d(0, 0, 0.5);

@@ -31,4 +31,8 @@ double success_translation_rotation(const std::vector<Pose>& estimated,
 /// Median of a list (0 for an empty list).
 double median(std::vector<double> values);
 
+/// Nearest-rank percentile (0 < percent <= 100) of a list: the smallest value with at least
+/// `percent` % of the list at or below it (0 for an empty list). percentile(v, 100) is the maximum.
+double percentile(std::vector<double> values, double percent);
+
 }  // namespace kct
