@@ -311,7 +311,9 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   const PinholeCamera& camera = tracker_->camera();
   const Pose& held_pose = held.object_to_camera;
   const PreparedFrame prepared = texture_->prepare(bgr, held_pose, camera);
-  const double held_correlation = texture_->agreement(prepared, held_pose, camera).correlation;
+  const TextureAgreement held_agreement = texture_->agreement(prepared, held_pose, camera);
+  const double held_correlation = held_agreement.correlation;
+  if (held_agreement.points >= SurfaceTexture::kMinPoints) result.texture_correlation = held_correlation;
   // Turns about the object's own axes through its centre, k x step for k = 1 .. n - 1.
   const Eigen::Vector3d& center = tracker_->center_object();
   const Eigen::Vector3d held_center = held_pose * center;

@@ -6,6 +6,7 @@
 /// when time jumps backwards (a looping bag), behind one track() call. Ours; the paper has no
 /// failure handling. The session owns no thread and does no I/O.
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -40,6 +41,9 @@ struct SessionResult {
   /// texture_check replaced the tracked pose by one turned about an object axis whose surface
   /// colours match the learned ones better.
   bool texture_corrected = false;
+  /// texture_check's correlation of the held pose's surface colours with the learned ones
+  /// (SurfaceTexture::agreement), in [-1, 1]; NaN when the check did not run on this frame.
+  double texture_correlation = std::numeric_limits<double>::quiet_NaN();
   ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
   bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
   bool restarted = false;    ///< ... and the session restarted from restart_pose()
