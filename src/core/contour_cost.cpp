@@ -1,4 +1,5 @@
 #include "klt_contour_tracker/core/contour_cost.h"
+#include "klt_contour_tracker/core/bilinear.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,25 +13,6 @@ namespace {
 constexpr double kMinDepth = 1e-6;  // metres, as the extractor
 constexpr double kContrastFactor = 8.0;
 constexpr double kReextractFraction = 0.01;
-
-/// Bilinear interpolation of a CV_32F image at (x0 + fx, y0 + fy); 0 <= x0 < cols - 1 and
-/// 0 <= y0 < rows - 1 guaranteed by the caller.
-inline double bilinear(const cv::Mat& image, int x0, int y0, double fx, double fy) {
-  const float* r0 = image.ptr<float>(y0) + x0;
-  const float* r1 = image.ptr<float>(y0 + 1) + x0;
-  const double top = r0[0] + fx * (r0[1] - r0[0]);
-  const double bottom = r1[0] + fx * (r1[1] - r1[0]);
-  return top + fy * (bottom - top);
-}
-
-/// d/dx and d/dy of bilinear() at the same point (exact, constant inside a pixel cell).
-inline Eigen::Vector2d bilinear_derivative(const cv::Mat& image, int x0, int y0, double fx,
-                                           double fy) {
-  const float* r0 = image.ptr<float>(y0) + x0;
-  const float* r1 = image.ptr<float>(y0 + 1) + x0;
-  return {(1.0 - fy) * (r0[1] - r0[0]) + fy * (r1[1] - r1[0]),
-          (1.0 - fx) * (r1[0] - r0[0]) + fx * (r1[1] - r0[1])};
-}
 
 }  // namespace
 

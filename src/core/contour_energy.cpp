@@ -1,4 +1,5 @@
 #include "klt_contour_tracker/core/contour_energy.h"
+#include "klt_contour_tracker/core/bilinear.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -10,16 +11,6 @@
 
 namespace kct {
 namespace {
-
-/// Bilinear interpolation of a CV_32F image; the caller guarantees 0 <= x0 < cols - 1 and
-/// 0 <= y0 < rows - 1.
-inline double bilinear(const cv::Mat& image, int x0, int y0, double fx, double fy) {
-  const float* r0 = image.ptr<float>(y0) + x0;
-  const float* r1 = image.ptr<float>(y0 + 1) + x0;
-  const double top = r0[0] + fx * (r0[1] - r0[0]);
-  const double bottom = r1[0] + fx * (r1[1] - r1[0]);
-  return top + fy * (bottom - top);
-}
 
 /// Walks the sample points of Eq. 5 and calls visit(point, normal, |grad . n|) for every point
 /// kept; returns the sum of the values and the number of points.

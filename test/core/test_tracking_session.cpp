@@ -199,6 +199,35 @@ struct ColourScene {
   }
 };
 
+/// What a correcting check (rotation_check, texture_check) did while an object came back.
+struct CheckRun {
+  SessionResult last;        ///< the last frame's result
+  int first_corrected = -1;  ///< first shown frame the check corrected (-1: none)
+  int corrections = 0;       ///< shown frames it corrected
+};
+
+/// Tracks 8 frames of the object at `start`, one frame of the bare background (KLT fails: the
+/// checks' window opens), then 8 frames of it at `truth`, counting the frames whose `corrected`
+/// flag is set.
+CheckRun hide_and_show(TrackingSession& session, const Renderer& renderer, const PinholeCamera& camera,
+                       const cv::Mat& background, const Pose& start, const Pose& truth,
+                       bool SessionResult::*corrected) {
+  session.set_camera(camera);
+  session.initialize(start);
+  double stamp = 0.0;
+  for (int i = 0; i < 8; ++i, stamp += 0.033)
+    session.track({test::render_frame(renderer, camera, start, background, 1.5, i), stamp});
+  session.track({background.clone(), stamp});
+  stamp += 0.033;
+  CheckRun run;
+  for (int i = 0; i < 8; ++i, stamp += 0.033) {
+    run.last = session.track({test::render_frame(renderer, camera, truth, background, 1.5, 20 + i), stamp});
+    if (run.last.*corrected && run.first_corrected < 0) run.first_corrected = i;
+    run.corrections += run.last.*corrected ? 1 : 0;
+  }
+  return run;
+}
+
 /// The colour search of the realtime preset (color_search): a red box over a textured blue-grey
 /// background is hidden, then shown again 12 cm to the side and 8 deg turned, far outside the
 /// local refinement's reach; the session must find it again within 10 frames.
@@ -340,21 +369,11 @@ TEST(TrackingSession, RotationCheckCorrectsAWrongRotationTheTrackHolds) {
       TrackerParams params = quick_realtime();
       if (!check) params.rotation_check_deg = 0.0;
       TrackingSession session(scene.mesh, params);
-      session.set_camera(scene.camera);
-      session.initialize(scene.start);
-      double stamp = 0.0;
-      for (int i = 0; i < 8; ++i, stamp += 0.033)
-        session.track({test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
-      session.track({scene.background.clone(), stamp});
-      stamp += 0.033;
       const Pose truth = test::move(scene.start, turn_deg, Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero());
-      int first_corrected = -1, corrections = 0;
-      SessionResult r;
-      for (int i = 0; i < 8; ++i, stamp += 0.033) {
-        r = session.track({test::render_frame(scene.renderer, scene.camera, truth, scene.background, 1.5, 20 + i), stamp});
-        if (r.rotation_corrected && first_corrected < 0) first_corrected = i;
-        corrections += r.rotation_corrected ? 1 : 0;
-      }
+      const CheckRun run = hide_and_show(session, scene.renderer, scene.camera, scene.background, scene.start,
+                                         truth, &SessionResult::rotation_corrected);
+      const SessionResult& r = run.last;
+      const int first_corrected = run.first_corrected, corrections = run.corrections;
       const std::string what = "turn " + std::to_string(turn_deg) + (check ? " with" : " without") + " the check";
       ASSERT_EQ(r.state, TrackState::kTracking) << what;
       EXPECT_TRUE(r.good) << what;
@@ -392,22 +411,12 @@ TEST(TrackingSession, TextureCheckFindsATurnAboutTheObjectsAxis) {
       TrackerParams params = quick_realtime();
       if (!check) params.texture_check_margin = 0.0;
       TrackingSession session(cube, params);
-      session.set_camera(camera);
-      session.initialize(start);
-      double stamp = 0.0;
-      for (int i = 0; i < 8; ++i, stamp += 0.033)
-        session.track({test::render_frame(renderer, camera, start, background, 1.5, i), stamp});
-      session.track({background.clone(), stamp});
-      stamp += 0.033;
       Pose truth = start;
       truth.linear() = start.linear() * Eigen::AngleAxisd(turn_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      int first_corrected = -1, corrections = 0;
-      SessionResult r;
-      for (int i = 0; i < 8; ++i, stamp += 0.033) {
-        r = session.track({test::render_frame(renderer, camera, truth, background, 1.5, 20 + i), stamp});
-        if (r.texture_corrected && first_corrected < 0) first_corrected = i;
-        corrections += r.texture_corrected ? 1 : 0;
-      }
+      const CheckRun run =
+          hide_and_show(session, renderer, camera, background, start, truth, &SessionResult::texture_corrected);
+      const SessionResult& r = run.last;
+      const int first_corrected = run.first_corrected, corrections = run.corrections;
       const std::string what = "turn " + std::to_string(turn_deg) + (check ? " with" : " without") + " the check";
       ASSERT_EQ(r.state, TrackState::kTracking) << what;
       EXPECT_TRUE(r.good) << what;

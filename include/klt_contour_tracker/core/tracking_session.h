@@ -42,7 +42,8 @@ struct SessionResult {
   /// colours match the learned ones better.
   bool texture_corrected = false;
   /// texture_check's correlation of the held pose's surface colours with the learned ones
-  /// (SurfaceTexture::agreement), in [-1, 1]; NaN when the check did not run on this frame.
+  /// (SurfaceTexture::agreement), in [-1, 1]; NaN when the check did not run on this frame or
+  /// fewer than SurfaceTexture::kMinPoints learned points face the camera there.
   double texture_correlation = std::numeric_limits<double>::quiet_NaN();
   ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
   bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
