@@ -166,7 +166,7 @@ int main(int argc, char** argv) {
       trace.open(options.trace);
       if (!trace) throw std::runtime_error(options.trace + ": cannot write");
       trace << "frame,status,state,quality,good,klt_tracked,klt_inliers,energy_before,energy_after,"
-               "energy_level,color_contrast,color_level,searched,color_visible,relocalized,rotation_corrected,texture_corrected,texture_correlation\n";
+               "energy_level,color_contrast,color_level,searched,color_visible,relocalized,rotation_corrected,texture_corrected,texture_correlation,frame_ms\n";
     }
     run_options.on_frame = [&](size_t i, const cv::Mat& image, const kct::SessionResult& result,
                                const kct::TrackingSession& session) {
@@ -196,6 +196,7 @@ int main(int argc, char** argv) {
               << cv::format(",%.3f,%d,%d,%d,%.3f", result.color.valid ? result.color.visible_fraction : -1.0,
                             result.relocalized ? 1 : 0, result.rotation_corrected ? 1 : 0,
                             result.texture_corrected ? 1 : 0, result.texture_correlation)
+              << cv::format(",%.2f", f.frame_time_ms)
               << '\n';
       }
       if (!options.quiet) {
