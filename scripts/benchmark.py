@@ -356,13 +356,14 @@ def tail_table(rows, configs, key_rows):
          "period is a frame the nodelet's queue has to absorb).\n",
          "| object | " + " | ".join(tailed) + " |", "|---|" + "---|" * len(tailed)]
     for name, rr in key_rows:
+        if not rr:
+            continue
         cells = []
         for p in tailed:
             mine = [r for r in rr if r["preset"] == p and "p90_ms" in r]
             cells.append("%s (%s)" % (fmt(median([r["p90_ms"] for r in mine]), 1),
                                       fmt(max([r["max_ms"] for r in mine]) if mine else None, 0)))
-        if rr:
-            L.append("| %s | %s |" % (name, " | ".join(cells)))
+        L.append("| %s | %s |" % (name, " | ".join(cells)))
     L.append("")
     return L
 

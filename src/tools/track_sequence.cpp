@@ -212,6 +212,8 @@ int main(int argc, char** argv) {
     if (!options.output.empty()) kct::write_pose_file(options.output, run.object_to_camera, units);
 
     const kct::SessionStatistics& stats = run.statistics;
+    const double median_ms = kct::median(run.frame_ms), p90_ms = kct::percentile(run.frame_ms, 90),
+                 max_ms = kct::percentile(run.frame_ms, 100);
     std::ostringstream json;
     json << std::setprecision(6) << "{\n  \"sequence\": " << json_string(options.sequence)
          << ",\n  \"preset\": " << json_string(options.preset) << ",\n  \"frames\": " << frames
@@ -224,9 +226,8 @@ int main(int argc, char** argv) {
          << ",\n  \"reacquisitions\": " << stats.reacquisitions
          << ",\n  \"frames_to_reacquire\": [" << join(stats.frames_to_reacquire) << "]"
          << ",\n  \"startup_ms\": " << run.startup_ms
-         << ",\n  \"median_ms\": " << kct::median(run.frame_ms)
-         << ",\n  \"p90_ms\": " << kct::percentile(run.frame_ms, 90)
-         << ",\n  \"max_ms\": " << kct::percentile(run.frame_ms, 100) << ",\n  \"stage_median_ms\": {";
+         << ",\n  \"median_ms\": " << median_ms << ",\n  \"p90_ms\": " << p90_ms
+         << ",\n  \"max_ms\": " << max_ms << ",\n  \"stage_median_ms\": {";
     for (size_t k = 0; k < stages.size(); ++k)
       json << (k ? ", " : "") << "\"" << stages[k].first << "\": " << kct::median(stage_ms[k]);
     json << "}";
@@ -238,9 +239,9 @@ int main(int argc, char** argv) {
     std::printf("reacquisitions    %d  (frames from loss to re-acquired: %s)\n", stats.reacquisitions,
                 stats.frames_to_reacquire.empty() ? "-" : join(stats.frames_to_reacquire).c_str());
     std::printf("startup_ms        %.1f\n", run.startup_ms);
-    std::printf("median_ms         %.2f\n", kct::median(run.frame_ms));
-    std::printf("p90_ms            %.2f\n", kct::percentile(run.frame_ms, 90));
-    std::printf("max_ms            %.2f\n", kct::percentile(run.frame_ms, 100));
+    std::printf("median_ms         %.2f\n", median_ms);
+    std::printf("p90_ms            %.2f\n", p90_ms);
+    std::printf("max_ms            %.2f\n", max_ms);
 
     // Score the frames that have ground truth (pose.txt may hold more lines than images).
     int exit_code = 0;

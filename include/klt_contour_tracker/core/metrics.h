@@ -31,8 +31,9 @@ double success_translation_rotation(const std::vector<Pose>& estimated,
 /// Median of a list (0 for an empty list).
 double median(std::vector<double> values);
 
-/// Nearest-rank percentile (0 < percent <= 100) of a list: the smallest value with at least
-/// `percent` % of the list at or below it (0 for an empty list). percentile(v, 100) is the maximum.
+/// Nearest-rank percentile of a list: the smallest value with at least `percent` % of the list
+/// at or below it (0 for an empty list). `percent` is clamped to [0, 100]: 0 gives the minimum,
+/// 100 the maximum.
 double percentile(std::vector<double> values, double percent);
 
 }  // namespace kct
