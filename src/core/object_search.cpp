@@ -53,6 +53,11 @@ ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchS
   settings_.validate();
   diameter_m_ = mesh_->diameter();
   center_object_ = mesh_->bounding_box_center();
+  box_min_object_ = box_max_object_ = mesh_->vertices.front();
+  for (const Eigen::Vector3d& vertex : mesh_->vertices) {
+    box_min_object_ = box_min_object_.cwiseMin(vertex);
+    box_max_object_ = box_max_object_.cwiseMax(vertex);
+  }
 }
 
 bool ObjectSearch::looks_grey(const cv::Mat& bgr) {
@@ -123,6 +128,37 @@ bool ObjectSearch::learn(const cv::Mat& bgr, const Pose& object_to_camera,
   return histograms_.learn(small, mask, settings_.band_px, settings_.learning_rate);
 }
 
+cv::Rect ObjectSearch::silhouette_canvas(const Pose& object_to_camera,
+                                         const PinholeCamera& working_camera) const {
+  // At most one image size beyond the image on every side: a silhouette reaching further
+  // (the object at the lens) is cut there, as its visible share is small anyway.
+  const int width = working_camera.width(), height = working_camera.height();
+  const cv::Rect limit(-width, -height, 3 * width, 3 * height);
+  double u_min = 1e300, u_max = -1e300, v_min = 1e300, v_max = -1e300;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d point_object((corner & 1) ? box_max_object_.x() : box_min_object_.x(),
+                                       (corner & 2) ? box_max_object_.y() : box_min_object_.y(),
+                                       (corner & 4) ? box_max_object_.z() : box_min_object_.z());
+    const Eigen::Vector3d point_camera = object_to_camera * point_object;
+    if (!(point_camera.z() > 1e-3)) return limit;  // the box crosses the camera plane
+    const Eigen::Vector2d pixel = working_camera.project(point_camera);
+    u_min = std::min(u_min, pixel.x());
+    u_max = std::max(u_max, pixel.x());
+    v_min = std::min(v_min, pixel.y());
+    v_max = std::max(v_max, pixel.y());
+  }
+  if (!(u_max - u_min < 1e7 && v_max - v_min < 1e7)) return limit;  // NaN or absurd
+  // The projected box bounds the silhouette; the margin holds its ring (ring_width_px of a
+  // silhouette no larger than the box) and a pixel of rounding.
+  const double margin_px =
+      std::max(2.0, settings_.ring_fraction * std::max(u_max - u_min, v_max - v_min)) + 2.0;
+  const int x0 = static_cast<int>(std::floor(std::max(u_min - margin_px, -1e6)));
+  const int y0 = static_cast<int>(std::floor(std::max(v_min - margin_px, -1e6)));
+  const int x1 = static_cast<int>(std::ceil(std::min(u_max + margin_px, 1e6)));
+  const int y1 = static_cast<int>(std::ceil(std::min(v_max + margin_px, 1e6)));
+  return cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1) & limit;
+}
+
 SearchCandidate ObjectSearch::score(const cv::Mat& bgr, const Pose& object_to_camera,
                                     const PinholeCamera& camera) const {
   return score(bgr, std::vector<Pose>{object_to_camera}, camera).front();
@@ -138,20 +174,25 @@ std::vector<SearchCandidate> ObjectSearch::score(const cv::Mat& bgr,
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
   cv::Mat posterior;  // computed when the first pose needs it
-  // Rendered on a canvas one image size larger on every side, to know how much of the
-  // silhouette is outside the image.
-  const int pad_x = small.cols, pad_y = small.rows;
-  const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(),
-                                    working_camera.cx() + pad_x, working_camera.cy() + pad_y,
-                                    small.cols + 2 * pad_x, small.rows + 2 * pad_y);
-  const cv::Rect image_rect(pad_x, pad_y, small.cols, small.rows);
   RenderOptions options;
   options.draw_color = false;
   for (SearchCandidate& result : results) {
     if (!(result.object_to_camera.translation().z() > 0)) continue;
+    // Rendered on a canvas around the silhouette and its ring, not only the image: the share
+    // outside the image is the visible fraction's denominator.
+    const cv::Rect canvas_rect = silhouette_canvas(result.object_to_camera, working_camera);
+    if (canvas_rect.empty()) continue;
+    const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(),
+                                      working_camera.cx() - canvas_rect.x,
+                                      working_camera.cy() - canvas_rect.y, canvas_rect.width,
+                                      canvas_rect.height);
     const cv::Mat canvas = renderer_.render(result.object_to_camera, canvas_camera, options).mask();
     const double total = cv::countNonZero(canvas);
     if (total <= 0) continue;
+    // The image's part of the canvas, in canvas pixels.
+    const cv::Rect image_rect =
+        (cv::Rect(0, 0, small.cols, small.rows) & canvas_rect) - canvas_rect.tl();
+    if (image_rect.empty()) continue;
     const cv::Mat mask = canvas(image_rect);
     result.visible_fraction = cv::countNonZero(mask) / total;
     if (result.visible_fraction < settings_.min_visible_fraction) continue;
@@ -159,7 +200,8 @@ std::vector<SearchCandidate> ObjectSearch::score(const cv::Mat& bgr,
         ring_of(canvas, ring_width_px(canvas, settings_.ring_fraction))(image_rect);
     if (cv::countNonZero(ring) == 0) continue;
     if (posterior.empty()) posterior = posterior_map(small);
-    result.contrast = cv::mean(posterior, mask)[0] - cv::mean(posterior, ring)[0];
+    const cv::Mat posterior_visible = posterior(image_rect + canvas_rect.tl());
+    result.contrast = cv::mean(posterior_visible, mask)[0] - cv::mean(posterior_visible, ring)[0];
   }
   return results;
 }
@@ -172,7 +214,6 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
   const cv::Mat posterior = posterior_map(small);
-  const cv::Mat valid = cv::Mat::ones(small.size(), CV_32F);
   RenderOptions options;
   options.draw_color = false;
   for (double scale : settings_.depth_scales) {
@@ -194,27 +235,36 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
     cv::Mat inside_template, ring_template;
     mask.convertTo(inside_template, CV_32F, 1.0 / 255.0);
     ring.convertTo(ring_template, CV_32F, 1.0 / 255.0);
-    // Placements reaching outside the image: the frame padded with zeros (posterior and
-    // validity), so sums count only pixels inside it.
-    cv::Mat padded_posterior, padded_valid;
+    // Placements reaching outside the image: the posterior padded with zeros, so sums count
+    // only pixels inside it. The areas inside the image are the templates' sums over their
+    // overlap with the image rectangle: read from integral images, not correlated.
+    cv::Mat padded_posterior;
     cv::copyMakeBorder(posterior, padded_posterior, half, half, half, half, cv::BORDER_CONSTANT, 0);
-    cv::copyMakeBorder(valid, padded_valid, half, half, half, half, cv::BORDER_CONSTANT, 0);
-    cv::Mat posterior_inside, area_inside, posterior_ring, area_ring;
+    cv::Mat posterior_inside, posterior_ring;
     cv::matchTemplate(padded_posterior, inside_template, posterior_inside, cv::TM_CCORR);
-    cv::matchTemplate(padded_valid, inside_template, area_inside, cv::TM_CCORR);
     cv::matchTemplate(padded_posterior, ring_template, posterior_ring, cv::TM_CCORR);
-    cv::matchTemplate(padded_valid, ring_template, area_ring, cv::TM_CCORR);
+    cv::Mat inside_integral, ring_integral;
+    cv::integral(mask / 255, inside_integral, CV_32S);
+    cv::integral(ring / 255, ring_integral, CV_32S);
+    // Template pixels of the placement centred on image pixel (c, r) that fall in the image.
+    auto in_image = [&](const cv::Mat& integral, int r, int c) {
+      const int j0 = std::max(0, half - r), j1 = std::min(side, half - r + small.rows);
+      const int i0 = std::max(0, half - c), i1 = std::min(side, half - c + small.cols);
+      if (j0 >= j1 || i0 >= i1) return 0.0f;
+      return static_cast<float>(integral.at<int>(j1, i1) - integral.at<int>(j0, i1) -
+                                integral.at<int>(j1, i0) + integral.at<int>(j0, i0));
+    };
     const float min_area = static_cast<float>(settings_.min_visible_fraction * area);
     double best = -2.0;
     cv::Point best_at(-1, -1);
     for (int r = 0; r < posterior_inside.rows; ++r) {
       const float* pi = posterior_inside.ptr<float>(r);
-      const float* ai = area_inside.ptr<float>(r);
       const float* pr = posterior_ring.ptr<float>(r);
-      const float* ar = area_ring.ptr<float>(r);
       for (int c = 0; c < posterior_inside.cols; ++c) {
-        if (ai[c] < min_area || ar[c] < 1.0f) continue;
-        const double contrast = pi[c] / ai[c] - pr[c] / ar[c];
+        const float area_inside = in_image(inside_integral, r, c);
+        const float area_ring = in_image(ring_integral, r, c);
+        if (area_inside < min_area || area_ring < 1.0f) continue;
+        const double contrast = pi[c] / area_inside - pr[c] / area_ring;
         if (contrast > best) {
           best = contrast;
           best_at = {c, r};
@@ -227,7 +277,8 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
     candidate.object_to_camera = placed_at(reference, center_object_, working_camera,
                                            Eigen::Vector2d(best_at.x, best_at.y), depth_m);
     candidate.contrast = best;
-    candidate.visible_fraction = std::min(1.0, area_inside.at<float>(best_at) / area);
+    candidate.visible_fraction =
+        std::min(1.0, in_image(inside_integral, best_at.y, best_at.x) / area);
     candidates.push_back(candidate);
   }
   std::sort(candidates.begin(), candidates.end(),

@@ -73,6 +73,32 @@ TEST_F(ObjectSearchTest, VisibleFractionCountsTheSilhouetteOutsideTheImage) {
   EXPECT_EQ(search.score(frame_at(truth), outside, camera_).visible_fraction, 0.0);
 }
 
+TEST_F(ObjectSearchTest, VisibleFractionOfAnObjectLargerThanTheImage) {
+  ObjectSearch search(mesh_);
+  const Pose truth = test::make_pose(0.4);
+  ASSERT_TRUE(search.learn(frame_at(truth), truth, camera_));
+  // 6 cm from the camera the box's silhouette is wider than the image. Reference: the share
+  // of a full-resolution render on a canvas three images wide that falls in the image.
+  const Pose close = test::make_pose(0.06);
+  const int pad_x = camera_.width(), pad_y = camera_.height();
+  const PinholeCamera canvas_camera(camera_.fx(), camera_.fy(), camera_.cx() + pad_x,
+                                    camera_.cy() + pad_y, 3 * pad_x, 3 * pad_y);
+  RenderOptions options;
+  options.draw_color = false;
+  const cv::Mat canvas = renderer_->render(close, canvas_camera, options).mask();
+  const double expected = cv::countNonZero(canvas(cv::Rect(pad_x, pad_y, pad_x, pad_y))) /
+                          static_cast<double>(cv::countNonZero(canvas));
+  ASSERT_LT(expected, 0.9);
+  // Scored at half resolution: within 0.02 of the full-resolution share.
+  EXPECT_NEAR(search.score(frame_at(close), close, camera_).visible_fraction, expected, 0.02);
+  // The box reaching behind the camera: scored on the clipped render, no exception.
+  Pose straddling = truth;
+  straddling.translation().z() = 0.0;
+  const SearchCandidate behind = search.score(frame_at(truth), straddling, camera_);
+  EXPECT_GE(behind.visible_fraction, 0.0);
+  EXPECT_LE(behind.visible_fraction, 1.0);
+}
+
 TEST_F(ObjectSearchTest, FindsTheObjectFarFromTheReferencePose) {
   ObjectSearch search(mesh_);
   const Pose learned_at = test::make_pose(0.4);

@@ -87,6 +87,10 @@ class ObjectSearch {
   /// `bgr` at the working size and the camera scaled to it.
   cv::Mat working_image(const cv::Mat& bgr, const PinholeCamera& camera,
                         PinholeCamera& working_camera) const;
+  /// Where score() renders a pose's silhouette, in working-image pixels: the object's projected
+  /// bounding box with room for the ring, within one image size around the image.
+  cv::Rect silhouette_canvas(const Pose& object_to_camera,
+                             const PinholeCamera& working_camera) const;
   /// Per-pixel P(foreground | colour) of a working-size image, CV_32F.
   cv::Mat posterior_map(const cv::Mat& working_bgr) const;
 
@@ -96,6 +100,8 @@ class ObjectSearch {
   ColorHistograms histograms_;
   double diameter_m_ = 0.0;
   Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d box_min_object_ = Eigen::Vector3d::Zero();  ///< the mesh's bounding box
+  Eigen::Vector3d box_max_object_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace kct
