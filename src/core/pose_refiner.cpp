@@ -42,6 +42,20 @@ PoseRefiner::PoseRefiner(std::shared_ptr<const Mesh> mesh, const TrackerParams& 
 
 PoseRefiner::~PoseRefiner() = default;
 
+std::unique_ptr<PoseRefiner> PoseRefiner::replica() const {
+  std::unique_ptr<PoseRefiner> copy(new PoseRefiner());
+  copy->mesh_ = mesh_;
+  copy->params_ = params_;
+  copy->visibility_ = visibility_;
+  copy->extractor_ = std::make_shared<ContourExtractor>(mesh_, visibility_, params_.sharp_edge_angle_deg);
+  copy->energy_ = std::make_unique<ContourEnergy>(copy->extractor_, params_.contour_sample_spacing_px);
+  copy->size_m_ = size_m_;
+  copy->radius_m_ = radius_m_;
+  copy->center_object_ = center_object_;
+  copy->build_cues();
+  return copy;
+}
+
 void PoseRefiner::build_cues() {
   contour_cost_ = std::make_shared<ContourCost>(extractor_, params_.contour_sample_spacing_px,
                                                 params_.blur_sigma_px, params_.num_threads);

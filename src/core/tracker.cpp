@@ -115,6 +115,7 @@ void Tracker::set_params(const TrackerParams& params) {
   keypoints_.set_params(params_);
   if (params_.refine && !refiner_) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   if (refiner_) refiner_->set_params(params_);
+  hypothesis_refiner_.reset();  // made again from the refiner when next needed
   if (workers_->threads() != params_.num_threads)
     workers_ = std::make_unique<WorkerThreads>(params_.num_threads);
   if (motion_changed) configure_motion_model();
@@ -210,7 +211,7 @@ TrackResult Tracker::refine_hypothesis(const Frame& frame, const Pose& around,
 
 std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
                                                     const std::vector<Pose>& around,
-                                                    double search_scale) {
+                                                    double search_scale, bool shift_search) {
   const auto start = std::chrono::steady_clock::now();
   if (!(search_scale >= 1.0) || !std::isfinite(search_scale))
     throw std::invalid_argument("Tracker::reacquire: search_scale must be >= 1");
@@ -228,35 +229,46 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
   // The frame is converted once for every hypothesis; the search box is widened once.
   const bool refine = params_.refine && refiner_;
   const cv::Mat gray = refine ? to_gray(frame.image) : cv::Mat();
-  if (refine) {
-    TrackerParams widened = params_;
-    widened.extrapolated_rotation_bound_deg =
-        std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);
-    widened.extrapolated_axial_bound *= search_scale;
-    widened.extrapolated_lateral_bound *= search_scale;
-    refiner_->set_params(widened);  // only the box changes: nothing is rebuilt
-  }
-  std::vector<TrackResult> results;
-  results.reserve(around.size());
-  auto since = std::chrono::steady_clock::now();
-  try {
-    for (const Pose& pose : around) {
-      TrackResult result;
+  TrackerParams widened = params_;
+  widened.extrapolated_rotation_bound_deg =
+      std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);
+  widened.extrapolated_axial_bound *= search_scale;
+  widened.extrapolated_lateral_bound *= search_scale;
+  if (!shift_search) widened.shift_search_diameters = 0.0;
+  if (refine) refiner_->set_params(widened);  // only the box changes: nothing is rebuilt
+  // With two threads and more than one hypothesis, the odd ones are refined on the worker by a
+  // replica of the refiner: each refinement depends only on its hypothesis and the frame, so
+  // the results do not depend on the thread count.
+  const bool parallel = refine && around.size() >= 2 && workers_->threads() >= 2 &&
+                        params_.optimizer == "coarse_to_fine" && !refiner_->has_added_cues();
+  std::vector<TrackResult> results(around.size());
+  // `refiner` null: not refined (klt_only).
+  const auto refine_every_other = [&](PoseRefiner* refiner, std::size_t first, std::size_t step) {
+    for (std::size_t i = first; i < around.size(); i += step) {
+      TrackResult& result = results[i];
       result.status = TrackStatus::kReacquired;
-      result.object_to_camera = result.preliminary_object_to_camera = pose;
-      if (refine) apply_refinement(refiner_->refine(gray, camera_, pose, nullptr), result);
-      const auto now = std::chrono::steady_clock::now();
-      // The first hypothesis also carries the shared checks and conversion.
-      result.frame_time_ms =
-          std::chrono::duration<double, std::milli>(now - (results.empty() ? start : since)).count();
-      since = now;
-      results.push_back(std::move(result));
+      result.object_to_camera = result.preliminary_object_to_camera = around[i];
+      if (refiner) apply_refinement(refiner->refine(gray, camera_, around[i], nullptr), result);
+    }
+  };
+  try {
+    if (parallel) {
+      if (!hypothesis_refiner_) hypothesis_refiner_ = refiner_->replica();
+      hypothesis_refiner_->set_params(widened);
+      WorkerThreads::Pending odd =
+          workers_->start([&]() { refine_every_other(hypothesis_refiner_.get(), 1, 2); });
+      refine_every_other(refiner_.get(), 0, 2);
+      odd.wait();
+    } else {
+      refine_every_other(refine ? refiner_.get() : nullptr, 0, 1);
     }
   } catch (...) {
     if (refine) refiner_->set_params(params_);
     throw;
   }
   if (refine) refiner_->set_params(params_);
+  // The call's wall time on the first result (the others ran alongside or after it).
+  if (!results.empty()) results.front().frame_time_ms = elapsed_ms(start);
   return results;
 }
 

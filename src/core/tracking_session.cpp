@@ -267,7 +267,8 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
   const auto start = std::chrono::steady_clock::now();
   const std::vector<Pose> turned = turned_about_center(
       held.object_to_camera, tracker_->center_object(), params_.rotation_check_deg * M_PI / 180.0);
-  std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, turned, 1.0);
+  // Turned about the held pose's centre: the place is the held one's, no shift search.
+  std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, turned, 1.0, false);
   std::vector<Pose> poses{held.object_to_camera};
   for (const TrackResult& r : refined) poses.push_back(r.object_to_camera);
   const std::vector<SearchCandidate> scored = search_->score(bgr, poses, tracker_->camera());
@@ -423,6 +424,7 @@ void TrackingSession::use_colors(const cv::Mat& bgr, SessionResult& result) {
 }
 
 SessionResult TrackingSession::track(const Frame& frame) {
+  const auto start = std::chrono::steady_clock::now();
   SessionResult result;
   result.previous_state = monitor_.state();
   result.time_jumped_back = time_jumps_back(frame.stamp_s);
@@ -493,6 +495,9 @@ SessionResult TrackingSession::track(const Frame& frame) {
       frames_since_learning_ = 0;
     }
   }
+  // The whole call, checks, colour search and learning included (the parts above add up their
+  // own shares, which leave some of it out).
+  result.frame.frame_time_ms = elapsed_ms(start);
   count(result);
   return result;
 }

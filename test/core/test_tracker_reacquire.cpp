@@ -44,6 +44,43 @@ TEST(TrackerReacquire, RecoversAnOffsetPoseAndKeypointTrackingResumes) {
   EXPECT_LT(rotation_error_deg(tracked.object_to_camera, next), 2.0);
 }
 
+TEST(TrackerReacquire, HypothesesOnTwoThreadsGiveTheOneThreadResults) {
+  auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  Renderer renderer(mesh);
+  const PinholeCamera camera = test::make_camera();
+  const Pose truth = test::make_pose(0.45);
+  const cv::Mat frame = test::render_frame(renderer, camera, truth,
+                                           test::make_background(camera.size(), 5), 1.0, 1);
+  // Five hypotheses around the truth (an odd count: the threads get 3 and 2).
+  std::vector<Pose> around;
+  for (int k = 0; k < 5; ++k)
+    around.push_back(test::move(truth, 2.0 * k, {0.3, 1.0, 0.2}, {0.004 * k, -0.002 * k, 0.0}));
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 2;
+  params.visibility_resolution_px = 128;
+  params.num_threads = 1;
+  Tracker serial(mesh, camera, params);
+  params.num_threads = 2;
+  Tracker parallel(mesh, camera, params);
+  for (const bool shift_search : {true, false}) {
+    const std::vector<TrackResult> one = serial.refine_hypotheses({frame, 0.1}, around, 1.0, shift_search);
+    const std::vector<TrackResult> two = parallel.refine_hypotheses({frame, 0.1}, around, 1.0, shift_search);
+    ASSERT_EQ(one.size(), around.size());
+    ASSERT_EQ(two.size(), around.size());
+    for (std::size_t i = 0; i < around.size(); ++i) {
+      SCOPED_TRACE(i);
+      EXPECT_TRUE(one[i].refined);
+      EXPECT_EQ(two[i].status, TrackStatus::kReacquired);
+      // Bit for bit: each refinement depends only on its hypothesis and the frame.
+      EXPECT_EQ((one[i].object_to_camera.matrix() - two[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(),
+                0.0);
+      EXPECT_EQ(one[i].energy_after, two[i].energy_after);
+    }
+    // The refinement did its work: the hypotheses closest to the truth end within 3 mm.
+    EXPECT_LT(translation_error(two[1].object_to_camera, truth), 0.003);
+  }
+}
+
 TEST(TrackerReacquire, WithoutRefinementTheGivenPoseIsTaken) {
   auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
   Tracker tracker(mesh, test::make_camera(), make_preset("klt_only"));

@@ -46,6 +46,15 @@ class PoseRefiner {
   PoseRefiner(std::shared_ptr<const Mesh> mesh, const TrackerParams& params);
   ~PoseRefiner();
 
+  /// A second refiner of the same mesh and parameters for another thread: it shares the
+  /// visibility table (immutable) and has its own contour extractor (whose caches are not
+  /// shared between threads) and its own contour and keypoint cues, but none of the cues
+  /// add_cue() added. Its refine() gives the same result as this one's when this one has no
+  /// added cue (coarse_to_fine; basin_hopping seeds from a per-refiner frame counter).
+  std::unique_ptr<PoseRefiner> replica() const;
+  /// True when cues were added with add_cue().
+  bool has_added_cues() const { return !extra_cues_.empty(); }
+
   /// Refines `preliminary` on `gray` (CV_8UC1). `keypoints` holds the KLT inliers when the
   /// preliminary pose came from PnP (search area = reprojection constraint, Sec. 3.4), or is
   /// null when it was extrapolated (search area = Euler/translation box).
@@ -76,6 +85,7 @@ class PoseRefiner {
   std::shared_ptr<const ContourExtractor> shared_contour_extractor() const { return extractor_; }
 
  private:
+  PoseRefiner() = default;  ///< for replica()
   std::shared_ptr<const Mesh> mesh_;
   TrackerParams params_;
   std::shared_ptr<const VisibilityTable> visibility_;

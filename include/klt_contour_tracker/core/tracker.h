@@ -94,9 +94,14 @@ class Tracker {
   /// re-acquisition hypotheses on one frame). Same exceptions as reacquire().
   TrackResult refine_hypothesis(const Frame& frame, const Pose& around, double search_scale);
   /// refine_hypothesis() for several poses on one frame (converted once); one result per pose,
-  /// in order. All kInvalidInput when the frame is unusable.
+  /// in order. All kInvalidInput when the frame is unusable. With num_threads >= 2 (and the
+  /// coarse_to_fine optimizer without region or motion-prior cue) the hypotheses are refined on
+  /// two threads, with the same results. The first result's frame_time_ms is the whole call's
+  /// wall time, the others' 0. `shift_search` false: no image-plane shift search
+  /// (shift_search_diameters), for hypotheses whose place is known (only their rotation is in
+  /// question).
   std::vector<TrackResult> refine_hypotheses(const Frame& frame, const std::vector<Pose>& around,
-                                             double search_scale);
+                                             double search_scale, bool shift_search = true);
   /// The rest of reacquire(): tracking continues from `result` (a refine_hypothesis() result on
   /// `frame`; anything else is ignored), keypoints re-anchored there; adds the time to it.
   void adopt(const Frame& frame, TrackResult& result);
@@ -148,6 +153,8 @@ class Tracker {
   TrackerParams params_;
   KeypointTracker keypoints_;
   std::unique_ptr<PoseRefiner> refiner_;
+  /// refine_hypotheses()' second thread's refiner (a replica of refiner_), made when needed.
+  std::unique_ptr<PoseRefiner> hypothesis_refiner_;
   std::unique_ptr<MotionModel> motion_;  ///< null unless params_.motion_model
   std::shared_ptr<RegionCost> region_cost_;       ///< null unless region_weight > 0
   std::shared_ptr<MotionPriorCost> motion_prior_;  ///< null unless motion_prior_weight > 0

@@ -25,7 +25,9 @@ namespace kct {
 
 /// What one TrackingSession::track() call did.
 struct SessionResult {
-  TrackResult frame;                                   ///< the pipeline's result (poses in metres)
+  /// The pipeline's result (poses in metres); its frame_time_ms is the wall time of the whole
+  /// TrackingSession::track() call.
+  TrackResult frame;
   TrackState previous_state = TrackState::kWaitingForPose;  ///< state before this frame
   TrackState state = TrackState::kWaitingForPose;      ///< state after this frame
   double quality = 0.0;      ///< the monitor's score in [0, 1]; 0 when the frame has no pose
