@@ -299,10 +299,12 @@ class Runner:
                 summary["errors"] = [float(x) for x in f.read().split()]
         # The session's per-frame verdict (the trace's `good`: what ~status tells a ROS user),
         # absent from results made before the trace was written.
-        summary["good"] = None
+        summary["good"] = summary["states"] = None
         if os.path.exists(base + ".trace.csv"):
             with open(base + ".trace.csv") as f:
-                summary["good"] = [row["good"] == "1" for row in csv.DictReader(f)]
+                trace = list(csv.DictReader(f))
+            summary["good"] = [row["good"] == "1" for row in trace]
+            summary["states"] = [row["state"] for row in trace]
         summary.update(preset=label, wall_s=time.time() - t0, poses_file=base + ".poses.txt")
         return summary
 
@@ -396,6 +398,7 @@ def stage_table(rows, configs, key_rows):
 # many frames.
 REACQUIRE_WITHIN_FRAMES = 10
 SESSION_COLUMNS = ["losses", "re-acquired", "within %d frames" % REACQUIRE_WITHIN_FRAMES,
+                   "within %d frames, right" % REACQUIRE_WITHIN_FRAMES,
                    "median frames to re-acquire", "frames lost"]
 
 
@@ -438,16 +441,36 @@ def verdict_cells(rows):
             "%.2f" % lost, count_share(len(bad), len(pairs)), count_share(len(right_bad), len(bad))]
 
 
+def reacquired_right_in_time(row):
+    """Re-acquisitions of `row` (from its trace's states) within REACQUIRE_WITHIN_FRAMES of the
+    loss whose pose at the re-acquisition frame is right (error < WRONG_POSE_DIAMETERS
+    diameters); None without a trace."""
+    states, errors = row.get("states"), row.get("errors", [])
+    if states is None or len(states) != len(errors):
+        return None
+    right, lost_at = 0, None
+    for i in range(1, len(states)):
+        if states[i - 1] == "tracking" and states[i] == "lost":
+            lost_at = i
+        elif states[i - 1] == "lost" and states[i] == "tracking" and lost_at is not None:
+            if i - lost_at <= REACQUIRE_WITHIN_FRAMES and errors[i] < WRONG_POSE_DIAMETERS * row["diameter_m"]:
+                right += 1
+            lost_at = None
+    return right
+
+
 def session_cells(rows):
-    """Losses, re-acquisitions (all; within REACQUIRE_WITHIN_FRAMES, share of the losses), the
-    median number of frames from a loss to its re-acquisition and the frames spent lost, summed
-    over `rows`."""
+    """Losses, re-acquisitions (all; within REACQUIRE_WITHIN_FRAMES, share of the losses; of
+    those, the ones whose pose is right), the median number of frames from a loss to its
+    re-acquisition and the frames spent lost, summed over `rows`."""
     frames = [int(f) for r in rows for f in r.get("frames_to_reacquire", [])]
     within = sum(1 for f in frames if f <= REACQUIRE_WITHIN_FRAMES)
     losses = sum(int(r.get("losses", 0)) for r in rows)
+    right = [reacquired_right_in_time(r) for r in rows]
     middle = median(frames)
     return [str(losses), str(sum(int(r.get("reacquisitions", 0)) for r in rows)),
             count_share(within, losses),
+            count_share(sum(right), losses) if None not in right else "-",
             "%g" % middle if middle is not None else "-", str(sum(int(r.get("frames_lost", 0)) for r in rows))]
 
 
@@ -569,9 +592,12 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
         leave_args = HARD_CONDITIONS["leave"][1]
         L.append("A loss: the session's state goes from tracking to lost; re-acquired: it tracks again "
                  "before the sequence ends; *within %d frames*: counted from the loss, so the frames the "
-                 "object spends outside the image (leave: %s) or behind the occluder count too; the "
+                 "object spends outside the image (leave: %s) or behind the occluder count too; *right*: "
+                 "of those, the ones whose pose at the re-acquisition frame is off by less than %g "
+                 "diameters (a re-acquisition on a distractor counts in the other columns); the "
                  "median is over the re-acquired losses.\n"
-                 % (REACQUIRE_WITHIN_FRAMES, leave_args[leave_args.index("--leave-frames") + 1]))
+                 % (REACQUIRE_WITHIN_FRAMES, leave_args[leave_args.index("--leave-frames") + 1],
+                    WRONG_POSE_DIAMETERS))
         L.append("| preset | condition | " + " | ".join(keys) + " |")
         L.append("|---|---|" + "---|" * len(keys))
         for p in labels:
