@@ -242,6 +242,61 @@ double ContourCost::energy(const Pose& object_to_camera, int* num_points) const 
   return count > 0 ? sum / count : 0.0;
 }
 
+std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
+                                                  const std::vector<Eigen::Vector3d>& shifts_camera,
+                                                  std::vector<int>* num_points) const {
+  std::vector<double> energies(shifts_camera.size(), 0.0);
+  if (num_points) num_points->assign(shifts_camera.size(), 0);
+  if (!frame_ || levels_.empty() || levels_[level_].roi.empty()) return energies;
+  // accumulate() without derivatives, on points moved to the camera frame once.
+  const LevelImages& images = levels_[level_];
+  const PinholeCamera& camera = frame_->levels[level_].camera;
+  const double fx = camera.fx(), fy = camera.fy(), cx = camera.cx(), cy = camera.cy();
+  const double x_lo = images.roi.x + 1.0, y_lo = images.roi.y + 1.0;
+  const double x_hi = images.roi.x + images.roi.width - 2.0;
+  const double y_hi = images.roi.y + images.roi.height - 2.0;
+  std::vector<Eigen::Vector3d> ends_camera(2 * segments_.size()), samples_camera(samples_.size());
+  for (std::size_t i = 0; i < segments_.size(); ++i) {
+    ends_camera[2 * i] = object_to_camera * segments_[i].a_object;
+    ends_camera[2 * i + 1] = object_to_camera * segments_[i].b_object;
+  }
+  for (std::size_t k = 0; k < samples_.size(); ++k) samples_camera[k] = object_to_camera * samples_[k];
+  Eigen::Matrix2d perp;
+  perp << 0.0, -1.0, 1.0, 0.0;
+  for (std::size_t s = 0; s < shifts_camera.size(); ++s) {
+    const Eigen::Vector3d& shift = shifts_camera[s];
+    double sum = 0.0;
+    int kept = 0;
+    for (std::size_t i = 0; i < segments_.size(); ++i) {
+      const Segment& segment = segments_[i];
+      const Eigen::Vector3d a = ends_camera[2 * i] + shift, b = ends_camera[2 * i + 1] + shift;
+      if (a.z() <= kMinDepth || b.z() <= kMinDepth) continue;
+      const Eigen::Vector2d pa(fx * a.x() / a.z() + cx, fy * a.y() / a.z() + cy);
+      const Eigen::Vector2d pb(fx * b.x() / b.z() + cx, fy * b.y() / b.z() + cy);
+      const Eigen::Vector2d d = pb - pa;
+      const double length = d.norm();
+      if (!(length > 1e-9) || !std::isfinite(length)) continue;
+      const Eigen::Vector2d normal = perp * d / length;
+      for (int k = segment.first_sample; k < segment.end_sample; ++k) {
+        const Eigen::Vector3d x = samples_camera[k] + shift;
+        if (x.z() <= kMinDepth) continue;
+        const double u = fx * x.x() / x.z() + cx, v = fy * x.y() / x.z() + cy;
+        if (!(u >= x_lo && v >= y_lo && u <= x_hi && v <= y_hi)) continue;
+        const double lu = u - images.roi.x, lv = v - images.roi.y;
+        const int x0 = std::min(static_cast<int>(lu), images.roi.width - 2);
+        const int y0 = std::min(static_cast<int>(lv), images.roi.height - 2);
+        const double ax = lu - x0, ay = lv - y0;
+        sum += std::abs(bilinear(images.gx, x0, y0, ax, ay) * normal.x() +
+                        bilinear(images.gy, x0, y0, ax, ay) * normal.y());
+        ++kept;
+      }
+    }
+    energies[s] = kept > 0 ? sum / kept : 0.0;
+    if (num_points) (*num_points)[s] = kept;
+  }
+  return energies;
+}
+
 double ContourCost::evaluate(const Pose& object_to_camera, Vector6d* gradient,
                              Matrix6d* hessian) const {
   if (!frame_ || levels_.empty() || levels_[level_].roi.empty()) return 0.0;

@@ -284,23 +284,23 @@ bool PoseRefiner::search_shift(const Pose& preliminary, Pose* shifted) {
   // A shift must clearly beat staying put (kMinGain x the energy): the object leaving the
   // image or an occluder's edge otherwise lure the pose to whatever edges are near.
   constexpr double kMinGain = 1.5;
-  double best_energy = kMinGain * base_energy;
-  Eigen::Vector3d best_shift = Eigen::Vector3d::Zero();
-  for (int j = -steps; j <= steps; ++j) {
+  std::vector<Eigen::Vector3d> shifts;
+  for (int j = -steps; j <= steps; ++j)
     for (int i = -steps; i <= steps; ++i) {
       if ((i == 0 && j == 0) || i * i + j * j > steps * steps) continue;
-      const Eigen::Vector3d shift(i * step_px * center_camera.z() / camera.fx(),
-                                  j * step_px * center_camera.z() / camera.fy(), 0.0);
-      Pose candidate = preliminary;
-      candidate.translation() += shift;
-      int count = 0;
-      const double energy = contour_cost_->energy(candidate, &count);
-      // A shift that keeps too few of the points in the image (or the gradients' region of
-      // interest) is not comparable.
-      if (count < 0.7 * base_count || !(energy > best_energy)) continue;
-      best_energy = energy;
-      best_shift = shift;
+      shifts.emplace_back(i * step_px * center_camera.z() / camera.fx(),
+                          j * step_px * center_camera.z() / camera.fy(), 0.0);
     }
+  std::vector<int> counts;
+  const std::vector<double> energies = contour_cost_->shifted_energies(preliminary, shifts, &counts);
+  double best_energy = kMinGain * base_energy;
+  Eigen::Vector3d best_shift = Eigen::Vector3d::Zero();
+  for (std::size_t s = 0; s < shifts.size(); ++s) {
+    // A shift that keeps too few of the points in the image (or the gradients' region of
+    // interest) is not comparable.
+    if (counts[s] < 0.7 * base_count || !(energies[s] > best_energy)) continue;
+    best_energy = energies[s];
+    best_shift = shifts[s];
   }
   if (best_shift.isZero()) return false;
   *shifted = preliminary;

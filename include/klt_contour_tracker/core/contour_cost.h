@@ -57,6 +57,13 @@ class ContourCost : public PoseCost {
   /// Eq. 5 (intensity units per level px) at `object_to_camera` over the fixed points of the
   /// last linearize(), and the number of points kept; for tests and diagnostics.
   double energy(const Pose& object_to_camera, int* num_points = nullptr) const;
+  /// energy() at `object_to_camera` moved by each of `shifts_camera` (camera-frame
+  /// translations), with each shift's number of points in `num_points` (resized): the fixed
+  /// points are transformed to the camera frame once for all shifts (the refiner's shift search
+  /// scores up to ~1300 shifts of one pose).
+  std::vector<double> shifted_energies(const Pose& object_to_camera,
+                                       const std::vector<Eigen::Vector3d>& shifts_camera,
+                                       std::vector<int>* num_points) const;
   /// The contrast scale c of the current level (see the class comment).
   double contrast_scale() const;
   /// Edge width sigma (level px) used by the Hessian approximation: sqrt(blur^2 + 1).
