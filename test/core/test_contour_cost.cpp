@@ -154,6 +154,33 @@ TEST_F(ContourCostTest, EnergyIsHighestAndCostLowestAtTheTruePose) {
   EXPECT_GT(cost.evaluate(truth_, nullptr, nullptr), -3.0);
 }
 
+TEST_F(ContourCostTest, ShiftedEnergiesAreTheEnergiesOfTheShiftedPoses) {
+  ContourCost cost(extractor_, 2.0, 1.0);
+  cost.begin_frame(frame_);
+  const Pose pose = test::move(truth_, 1.0, {0.3, 1.0, -0.2}, {0.004, -0.003, 0.002});
+  cost.linearize(pose, 2);
+  // Shifts within the image and one taking most points out of the gradients' region.
+  const std::vector<Eigen::Vector3d> shifts{
+      {0.0, 0.0, 0.0}, {-0.004, 0.003, 0.0}, {0.01, 0.0, 0.0}, {0.0, -0.02, 0.0}, {2.0, 0.0, 0.0}};
+  std::vector<int> counts;
+  const std::vector<double> energies = cost.shifted_energies(pose, shifts, &counts);
+  ASSERT_EQ(energies.size(), shifts.size());
+  ASSERT_EQ(counts.size(), shifts.size());
+  for (std::size_t i = 0; i < shifts.size(); ++i) {
+    Pose shifted = pose;
+    shifted.translation() += shifts[i];
+    int count = 0;
+    const double expected = cost.energy(shifted, &count);
+    EXPECT_EQ(counts[i], count) << i;
+    // The same sum, rounded differently (points moved before or after the shift).
+    EXPECT_NEAR(energies[i], expected, 1e-9 * std::max(1.0, expected)) << i;
+  }
+  EXPECT_GT(counts[0], 0);
+  EXPECT_EQ(counts[4], 0);  // 2 m aside: outside the image
+  // The shift back to the truth scores higher than staying.
+  EXPECT_GT(energies[1], energies[0]);
+}
+
 TEST_F(ContourCostTest, ResultDoesNotDependOnTheThreadCount) {
   ContourCost one(extractor_, 2.0, 1.0, 1), two(extractor_, 2.0, 1.0, 2);
   one.begin_frame(frame_);
