@@ -133,7 +133,8 @@ void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
   monitor_.set_params(quality);
 }
 
-TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched) {
+TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched,
+                                       bool color_only) {
   searched = false;
   const Pose& last_good = monitor_.last_good_pose();
   if (search_ && search_->ready() && !bgr.empty() &&
@@ -197,6 +198,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       return best;
     }
   }
+  if (color_only) return TrackResult();
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 
@@ -257,6 +259,22 @@ bool TrackingSession::checkable(const TrackResult& held, const cv::Mat& bgr) con
   return search_ && search_->ready() && !bgr.empty() && held.refined &&
          monitor_.color_level() >= TrackQualityMonitor::kMinColorLevel &&
          (held.status == TrackStatus::kKeypoints || held.status == TrackStatus::kExtrapolated);
+}
+
+void TrackingSession::check_extrapolated(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
+  const TrackResult& held = result.frame;
+  if (!(params_.extrapolated_search_ratio > 0.0) || held.status != TrackStatus::kExtrapolated ||
+      !checkable(held, bgr))
+    return;
+  const SearchCandidate scored = search_->score(bgr, held.object_to_camera, tracker_->camera());
+  result.color = evidence_of(scored);  // the held pose's colours, for use_colors
+  if (!(scored.contrast < params_.extrapolated_search_ratio * monitor_.color_level())) return;
+  bool searched = false;
+  const TrackResult found = reacquire(frame, bgr, searched, true);
+  if (!searched) return;
+  result.frame = found;
+  result.searched = true;
+  result.color = ColorEvidence();  // scored again at the found pose
 }
 
 void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
@@ -464,6 +482,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
         result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
     result.frame.frame_time_ms += relocalize_ms;  // a search of the keyframes that found nothing
     if (!gray.empty()) use_features(frame, gray, result);
+    check_extrapolated(frame, bgr, result);
     check_rotation(frame, bgr, result);  // only on tracked frames (kKeypoints, kExtrapolated)
     if (!result.rotation_corrected) check_texture(frame, bgr, result);
   }

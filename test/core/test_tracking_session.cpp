@@ -268,6 +268,42 @@ TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
   }
 }
 
+/// extrapolated_search_ratio: the red box jumps 18 cm sideways between two frames (too far for
+/// KLT and for the shift search). The refined pose of the jump frame has lost the colours; with
+/// the ratio the colour search runs on that frame and finds the box there, without it the track
+/// is not searched on that frame (the session has not declared the loss yet).
+TEST(TrackingSession, AJumpIsSearchedForOnTheFrameItHappens) {
+  const ColourScene scene;
+  const Pose away = test::move(scene.start, 8.0, {0.2, 1.0, 0.3}, {-0.15, 0.1, 0.0});
+  TrackerParams params = quick_realtime();
+  ASSERT_GT(params.extrapolated_search_ratio, 0.0) << "realtime searches at once";
+  for (const double ratio : {0.0, params.extrapolated_search_ratio}) {
+    params.extrapolated_search_ratio = ratio;
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.initialize(scene.start);
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033) {
+      const SessionResult r = session.track(
+          {test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
+      ASSERT_EQ(r.state, TrackState::kTracking) << i;
+    }
+    const SessionResult jump = session.track(
+        {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 30), stamp});
+    EXPECT_FALSE(jump.reacquiring) << "the session was not lost before the jump";
+    if (ratio == 0.0) {
+      EXPECT_FALSE(jump.searched);
+      EXPECT_GT(translation_error(jump.frame.object_to_camera, away), 0.05) << "no jump: no test";
+    } else {
+      EXPECT_TRUE(jump.searched);
+      EXPECT_EQ(jump.frame.status, TrackStatus::kReacquired);
+      // Tolerance: 1 cm and 3 deg, as the other re-acquisition tests.
+      EXPECT_LT(translation_error(jump.frame.object_to_camera, away), 0.01);
+      EXPECT_LT(rotation_error_deg(jump.frame.object_to_camera, away), 3.0);
+    }
+  }
+}
+
 /// feature_relocalization: a textured box is hidden, then shown again 12 cm to the side and 8 deg
 /// turned (far outside the refinement's reach); with the colour search off, only the keyframe
 /// features of the initial pose can find it: re-acquired within 10 frames with, never without.

@@ -149,6 +149,12 @@ struct TrackerParams {
   /// its colour contrast passes color_accept_ratio. It catches turns about a symmetry axis (a
   /// can) that no outline or colour histogram can see.
   double texture_check_margin = 0.0;
+  /// ours (tracking session, 0 = off; needs color_search): on a frame where KLT failed and
+  /// whose refined pose's colour contrast is below this x the contrast level, the colour
+  /// search's re-acquisition runs at once on that frame, before the track is declared lost; its
+  /// pose replaces the refined one when it passes color_accept_ratio (or color_confirm_ratio).
+  /// A jump too fast for KLT and the shift search is found on the frame it happens.
+  double extrapolated_search_ratio = 0.0;
   double texture_check_step_deg = 10.0;  ///< see texture_check_margin
   /// texture_check runs on every tracked frame, not only in rotation_check's window, when the
   /// learned surface has a colour pattern (SurfaceTexture::has_color_pattern(): printed or

@@ -117,7 +117,11 @@ class TrackingSession {
   void clear_statistics() { statistics_ = {}; }
 
  private:
-  TrackResult reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched);
+  /// Re-acquisition while lost: the colour search's hypotheses, else (not `color_only`) a
+  /// refinement around the last good pose. `color_only` and nothing found: a default result
+  /// (searched false).
+  TrackResult reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched,
+                        bool color_only = false);
   void count(const SessionResult& result);
   /// feature_relocalization, on a frame the pipeline tracked (`gray` undistorted): the
   /// keyframes' features around the held pose confirm it, or replace it when they disagree.
@@ -129,6 +133,9 @@ class TrackingSession {
   /// (kReacquired, relocalized) with `frame_time_ms` so far.
   void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, double frame_time_ms,
                          SessionResult& result);
+  /// extrapolated_search_ratio: a frame where KLT failed and the refinement lost the colours
+  /// is searched for the object at once.
+  void check_extrapolated(const Frame& frame, const cv::Mat& bgr, SessionResult& result);
   /// rotation_check's and texture_check's common ground: the colour model is ready, the frame
   /// is in colour and `held` is a refined tracked pose (kKeypoints, kExtrapolated).
   bool checkable(const TrackResult& held, const cv::Mat& bgr) const;
