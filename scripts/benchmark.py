@@ -58,6 +58,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_texture_check", "realtime", {"texture_check_margin": "0"}),
     # ... checked only in rotation_check's window, also for objects with a colour pattern
     ("realtime_texture_check_in_window", "realtime", {"texture_check_every_frame": "false"}),
+    # a KLT failure whose refined pose lost the colours waits for the declared loss to be searched
+    ("realtime_no_extrapolated_search", "realtime", {"extrapolated_search_ratio": "0"}),
     # keypoints anchored after a KLT failure kept even when the frame is judged bad
     ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
