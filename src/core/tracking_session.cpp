@@ -165,11 +165,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, hypotheses, 1.0);
     if (refined.front().status != TrackStatus::kReacquired) return refined.front();  // invalid frame
     std::vector<Pose> refined_poses;
-    double time_ms = 0.0;
-    for (const TrackResult& r : refined) {
-      refined_poses.push_back(r.object_to_camera);
-      time_ms += r.frame_time_ms;
-    }
+    for (const TrackResult& r : refined) refined_poses.push_back(r.object_to_camera);
     const std::vector<SearchCandidate> scored = search_->score(bgr, refined_poses, camera);
     std::size_t best_index = 0;
     for (std::size_t i = 1; i < scored.size(); ++i)
@@ -193,7 +189,6 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       // track stays lost, a confirmed placement is not asked to wait a frame again.
       unconfirmed_ = best.object_to_camera;
       searched = true;
-      best.frame_time_ms = time_ms;
       tracker_->adopt(frame, best);
       return best;
     }
@@ -202,24 +197,19 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 
-bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result,
-                                  double& spent_ms) {
-  spent_ms = 0.0;
+bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
   if (relocalizer_->keyframes() == 0) return false;
-  const auto start = std::chrono::steady_clock::now();
   const Relocalization found = relocalizer_->locate(gray, tracker_->camera());
-  spent_ms = elapsed_ms(start);
   if (!found.found) return false;
-  adopt_relocalized(frame, found.object_to_camera, spent_ms, result);
+  adopt_relocalized(frame, found.object_to_camera, result);
   return true;
 }
 
 void TrackingSession::adopt_relocalized(const Frame& frame, const Pose& object_to_camera,
-                                        double frame_time_ms, SessionResult& result) {
+                                        SessionResult& result) {
   TrackResult located;
   located.status = TrackStatus::kReacquired;
   located.object_to_camera = located.preliminary_object_to_camera = object_to_camera;
-  located.frame_time_ms = frame_time_ms;
   tracker_->adopt(frame, located);
   result.frame = located;
   result.relocalized = true;
@@ -233,11 +223,8 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
     return;
   const Pose& held = result.frame.object_to_camera;
   const PinholeCamera& camera = tracker_->camera();
-  // The matching is part of the frame's work: its time counts in frame_time_ms.
-  const auto start = std::chrono::steady_clock::now();
   const Relocalization found =
       relocalizer_->locate(gray, camera, relocalizer_->region_around(held, camera, kRegionMargin));
-  result.frame.frame_time_ms += elapsed_ms(start);
   if (!found.found) return;
   const Eigen::Vector3d& center = tracker_->center_object();
   const double moved_m = ((found.object_to_camera * center) - (held * center)).norm();
@@ -252,7 +239,7 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   // 25 consistent but wrong matches.
   if (found.inliers < params_.relocalization_override_inliers) return;
   if (status == TrackStatus::kKeypoints && monitor_.last_good()) return;
-  adopt_relocalized(frame, found.object_to_camera, result.frame.frame_time_ms, result);
+  adopt_relocalized(frame, found.object_to_camera, result);
 }
 
 bool TrackingSession::checkable(const TrackResult& held, const cv::Mat& bgr) const {
@@ -282,7 +269,6 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
   if (!(params_.rotation_check_deg > 0.0) || !checkable(held, bgr) ||
       frames_since_doubt_ > params_.rotation_check_frames)
     return;
-  const auto start = std::chrono::steady_clock::now();
   const std::vector<Pose> turned = turned_about_center(
       held.object_to_camera, tracker_->center_object(), params_.rotation_check_deg * M_PI / 180.0);
   // Turned about the held pose's centre: the place is the held one's, no shift search.
@@ -300,7 +286,6 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
         scored[i].contrast >= scored[0].contrast + params_.rotation_check_margin * monitor_.color_level() &&
         scored[i].contrast > scored[best].contrast)
       best = i;
-  const double check_ms = elapsed_ms(start);
   // The same turn must win on two consecutive frames: a single win is often colour noise.
   const int winner = static_cast<int>(best) - 1;
   const bool confirmed = winner >= 0 && winner == rotation_check_winner_;
@@ -308,13 +293,11 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
   // The kept pose's colours are scored already (use_colors takes them).
   if (!confirmed) {
     result.color = evidence_of(scored[0]);
-    result.frame.frame_time_ms += check_ms;
     return;
   }
   result.color = evidence_of(scored[best]);
   rotation_check_winner_ = -1;
   TrackResult chosen = refined[best - 1];
-  chosen.frame_time_ms = held.frame_time_ms + check_ms;
   tracker_->adopt(frame, chosen);
   result.frame = chosen;
   result.rotation_corrected = true;
@@ -326,7 +309,6 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
       (frames_since_doubt_ > params_.rotation_check_frames &&
        !(params_.texture_check_every_frame && texture_->has_color_pattern())))
     return;
-  const auto start = std::chrono::steady_clock::now();
   const PinholeCamera& camera = tracker_->camera();
   const Pose& held_pose = held.object_to_camera;
   const PreparedFrame prepared = texture_->prepare(bgr, held_pose, camera);
@@ -374,10 +356,7 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   // The same turn must win on two consecutive frames before it is refined and tried.
   const bool confirmed = winner >= 0 && winner == texture_check_winner_;
   texture_check_winner_ = winner;
-  if (!confirmed) {
-    result.frame.frame_time_ms += elapsed_ms(start);
-    return;
-  }
+  if (!confirmed) return;
   texture_check_winner_ = -1;
   // Two ways the turn may replace the held pose. Refined (contour only), when it still matches
   // the surface better. Or as it is, when its outline is the held one's (its colour contrast
@@ -399,18 +378,13 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
       colors[1].contrast >= params_.color_accept_ratio * level;
   const bool same_outline = colors[2].contrast >= colors[0].contrast - kSameOutlineContrastTolerance * level &&
                             colors[2].contrast >= params_.color_accept_ratio * level;
-  const double check_ms = elapsed_ms(start);
-  if (!refined_better && !same_outline) {
-    result.frame.frame_time_ms += check_ms;
-    return;
-  }
+  if (!refined_better && !same_outline) return;
   TrackResult chosen = refined;
   if (!refined_better) {
     chosen = held;
     chosen.status = TrackStatus::kReacquired;
     chosen.object_to_camera = best_pose;
   }
-  chosen.frame_time_ms = held.frame_time_ms + check_ms;
   tracker_->adopt(frame, chosen);
   result.frame = chosen;
   result.color = evidence_of(colors[refined_better ? 1 : 2]);
@@ -476,11 +450,9 @@ SessionResult TrackingSession::track(const Frame& frame) {
   if (relocalizer_ && tracker_->check_frame(frame).empty())
     gray = tracker_->undistorted_gray(frame.image);
   features_confirm_ = false;
-  double relocalize_ms = 0.0;
-  if (!(result.reacquiring && !gray.empty() && relocalize(frame, gray, result, relocalize_ms))) {
+  if (!(result.reacquiring && !gray.empty() && relocalize(frame, gray, result))) {
     result.frame =
         result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
-    result.frame.frame_time_ms += relocalize_ms;  // a search of the keyframes that found nothing
     if (!gray.empty()) use_features(frame, gray, result);
     check_extrapolated(frame, bgr, result);
     check_rotation(frame, bgr, result);  // only on tracked frames (kKeypoints, kExtrapolated)
@@ -514,8 +486,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
       frames_since_learning_ = 0;
     }
   }
-  // The whole call, checks, colour search and learning included (the parts above add up their
-  // own shares, which leave some of it out).
+  // The whole call: tracking, checks, colour search and learning.
   result.frame.frame_time_ms = elapsed_ms(start);
   count(result);
   return result;

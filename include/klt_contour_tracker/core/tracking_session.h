@@ -127,12 +127,11 @@ class TrackingSession {
   /// keyframes' features around the held pose confirm it, or replace it when they disagree.
   void use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result);
   /// feature_relocalization, while lost: the keyframes' features over the whole frame; true
-  /// when they re-acquired the object (`result` then holds it). `spent_ms`: the matching's time.
-  bool relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result, double& spent_ms);
+  /// when they re-acquired the object (`result` then holds it).
+  bool relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result);
   /// The tracker continues from the relocalizer's `object_to_camera`; `result` reports it
-  /// (kReacquired, relocalized) with `frame_time_ms` so far.
-  void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, double frame_time_ms,
-                         SessionResult& result);
+  /// (kReacquired, relocalized).
+  void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, SessionResult& result);
   /// extrapolated_search_ratio: a frame where KLT failed and the refinement lost the colours
   /// is searched for the object at once.
   void check_extrapolated(const Frame& frame, const cv::Mat& bgr, SessionResult& result);
