@@ -14,6 +14,50 @@ constexpr double kMinDepth = 1e-6;  // metres, as the extractor
 constexpr double kContrastFactor = 8.0;
 constexpr double kReextractFraction = 0.01;
 
+/// Pinhole projection of camera-frame points (level intrinsics).
+struct Projection {
+  double fx, fy, cx, cy;
+  Eigen::Vector2d operator()(const Eigen::Vector3d& p) const {
+    return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
+  }
+};
+
+/// A contour segment's end points (camera frame) projected: its image direction `d`, length and
+/// unit normal. False when an end is behind the camera or the projection is degenerate.
+bool project_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Projection& project,
+                     Eigen::Vector2d* d, double* length, Eigen::Vector2d* normal) {
+  if (a.z() <= kMinDepth || b.z() <= kMinDepth) return false;
+  *d = project(b) - project(a);
+  *length = d->norm();
+  if (!(*length > 1e-9) || !std::isfinite(*length)) return false;
+  Eigen::Matrix2d perp;  // turns by +90 deg
+  perp << 0.0, -1.0, 1.0, 0.0;
+  *normal = perp * *d / *length;
+  return true;
+}
+
+/// Where a camera-frame point falls in gradient images covering `roi` (level px): the cell
+/// (x0, y0) relative to roi.tl() and the offsets (ax, ay) inside it. False when the point is
+/// behind the camera or not at least one pixel inside the region.
+struct Cell {
+  int x0, y0;
+  double ax, ay;
+};
+bool cell_of(const Eigen::Vector3d& x, const Projection& project, const cv::Rect& roi, Cell* cell) {
+  if (x.z() <= kMinDepth) return false;
+  const Eigen::Vector2d p = project(x);
+  const double u = p.x(), v = p.y();
+  if (!(u >= roi.x + 1.0 && v >= roi.y + 1.0 && u <= roi.x + roi.width - 2.0 &&
+        v <= roi.y + roi.height - 2.0))
+    return false;
+  const double lu = u - roi.x, lv = v - roi.y;
+  cell->x0 = std::min(static_cast<int>(lu), roi.width - 2);
+  cell->y0 = std::min(static_cast<int>(lv), roi.height - 2);
+  cell->ax = lu - cell->x0;
+  cell->ay = lv - cell->y0;
+  return true;
+}
+
 }  // namespace
 
 ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, double spacing_px,
@@ -166,10 +210,8 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
                                Matrix6d* hessian) const {
   const LevelImages& images = levels_[level_];
   const PinholeCamera& camera = frame_->levels[level_].camera;
-  const double fx = camera.fx(), fy = camera.fy(), cx = camera.cx(), cy = camera.cy();
-  const double x_lo = images.roi.x + 1.0, y_lo = images.roi.y + 1.0;
-  const double x_hi = images.roi.x + images.roi.width - 2.0;
-  const double y_hi = images.roi.y + images.roi.height - 2.0;
+  const double fx = camera.fx(), fy = camera.fy();
+  const Projection project{fx, fy, camera.cx(), camera.cy()};
   const bool derivatives = gradient || hessian;
   const Eigen::Matrix3d r = object_to_camera.linear();
   const Eigen::Vector3d t = object_to_camera.translation();
@@ -182,13 +224,9 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
   int kept = 0;
   for (const Segment& segment : segments_) {
     const Eigen::Vector3d a = r * segment.a_object + t, b = r * segment.b_object + t;
-    if (a.z() <= kMinDepth || b.z() <= kMinDepth) continue;
-    const Eigen::Vector2d pa(fx * a.x() / a.z() + cx, fy * a.y() / a.z() + cy);
-    const Eigen::Vector2d pb(fx * b.x() / b.z() + cx, fy * b.y() / b.z() + cy);
-    const Eigen::Vector2d d = pb - pa;
-    const double length = d.norm();
-    if (!(length > 1e-9) || !std::isfinite(length)) continue;
-    const Eigen::Vector2d normal = perp * d / length;
+    Eigen::Vector2d d, normal;
+    double length = 0.0;
+    if (!project_segment(a, b, project, &d, &length, &normal)) continue;
     Matrix26d normal_jacobian = Matrix26d::Zero();  // d normal / d delta
     if (derivatives) {
       const Matrix26d dd = projection_jacobian(b, center_camera, fx, fy) -
@@ -198,13 +236,10 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
     }
     for (int k = segment.first_sample; k < segment.end_sample; ++k) {
       const Eigen::Vector3d x = r * samples_[k] + t;
-      if (x.z() <= kMinDepth) continue;
-      const double u = fx * x.x() / x.z() + cx, v = fy * x.y() / x.z() + cy;
-      if (!(u >= x_lo && v >= y_lo && u <= x_hi && v <= y_hi)) continue;
-      const double lu = u - images.roi.x, lv = v - images.roi.y;
-      const int x0 = std::min(static_cast<int>(lu), images.roi.width - 2);
-      const int y0 = std::min(static_cast<int>(lv), images.roi.height - 2);
-      const double ax = lu - x0, ay = lv - y0;
+      Cell c;
+      if (!cell_of(x, project, images.roi, &c)) continue;
+      const int x0 = c.x0, y0 = c.y0;
+      const double ax = c.ax, ay = c.ay;
       const Eigen::Vector2d g(bilinear(images.gx, x0, y0, ax, ay),
                               bilinear(images.gy, x0, y0, ax, ay));
       const double along = g.dot(normal);
@@ -251,43 +286,29 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
   // accumulate() without derivatives, on points moved to the camera frame once.
   const LevelImages& images = levels_[level_];
   const PinholeCamera& camera = frame_->levels[level_].camera;
-  const double fx = camera.fx(), fy = camera.fy(), cx = camera.cx(), cy = camera.cy();
-  const double x_lo = images.roi.x + 1.0, y_lo = images.roi.y + 1.0;
-  const double x_hi = images.roi.x + images.roi.width - 2.0;
-  const double y_hi = images.roi.y + images.roi.height - 2.0;
+  const Projection project{camera.fx(), camera.fy(), camera.cx(), camera.cy()};
   std::vector<Eigen::Vector3d> ends_camera(2 * segments_.size()), samples_camera(samples_.size());
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     ends_camera[2 * i] = object_to_camera * segments_[i].a_object;
     ends_camera[2 * i + 1] = object_to_camera * segments_[i].b_object;
   }
   for (std::size_t k = 0; k < samples_.size(); ++k) samples_camera[k] = object_to_camera * samples_[k];
-  Eigen::Matrix2d perp;
-  perp << 0.0, -1.0, 1.0, 0.0;
   for (std::size_t s = 0; s < shifts_camera.size(); ++s) {
     const Eigen::Vector3d& shift = shifts_camera[s];
     double sum = 0.0;
     int kept = 0;
     for (std::size_t i = 0; i < segments_.size(); ++i) {
       const Segment& segment = segments_[i];
-      const Eigen::Vector3d a = ends_camera[2 * i] + shift, b = ends_camera[2 * i + 1] + shift;
-      if (a.z() <= kMinDepth || b.z() <= kMinDepth) continue;
-      const Eigen::Vector2d pa(fx * a.x() / a.z() + cx, fy * a.y() / a.z() + cy);
-      const Eigen::Vector2d pb(fx * b.x() / b.z() + cx, fy * b.y() / b.z() + cy);
-      const Eigen::Vector2d d = pb - pa;
-      const double length = d.norm();
-      if (!(length > 1e-9) || !std::isfinite(length)) continue;
-      const Eigen::Vector2d normal = perp * d / length;
+      Eigen::Vector2d d, normal;
+      double length = 0.0;
+      if (!project_segment(ends_camera[2 * i] + shift, ends_camera[2 * i + 1] + shift, project, &d,
+                           &length, &normal))
+        continue;
       for (int k = segment.first_sample; k < segment.end_sample; ++k) {
-        const Eigen::Vector3d x = samples_camera[k] + shift;
-        if (x.z() <= kMinDepth) continue;
-        const double u = fx * x.x() / x.z() + cx, v = fy * x.y() / x.z() + cy;
-        if (!(u >= x_lo && v >= y_lo && u <= x_hi && v <= y_hi)) continue;
-        const double lu = u - images.roi.x, lv = v - images.roi.y;
-        const int x0 = std::min(static_cast<int>(lu), images.roi.width - 2);
-        const int y0 = std::min(static_cast<int>(lv), images.roi.height - 2);
-        const double ax = lu - x0, ay = lv - y0;
-        sum += std::abs(bilinear(images.gx, x0, y0, ax, ay) * normal.x() +
-                        bilinear(images.gy, x0, y0, ax, ay) * normal.y());
+        Cell c;
+        if (!cell_of(samples_camera[k] + shift, project, images.roi, &c)) continue;
+        sum += std::abs(bilinear(images.gx, c.x0, c.y0, c.ax, c.ay) * normal.x() +
+                        bilinear(images.gy, c.x0, c.y0, c.ax, c.ay) * normal.y());
         ++kept;
       }
     }
