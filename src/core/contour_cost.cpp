@@ -22,17 +22,15 @@ struct Projection {
   }
 };
 
-/// A contour segment's end points (camera frame) projected: its image direction `d`, length and
-/// unit normal. False when an end is behind the camera or the projection is degenerate.
+/// A contour segment's end points (camera frame) projected: its image length and unit normal.
+/// False when an end is behind the camera or the projection is degenerate.
 bool project_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Projection& project,
-                     Eigen::Vector2d* d, double* length, Eigen::Vector2d* normal) {
+                     double* length, Eigen::Vector2d* normal) {
   if (a.z() <= kMinDepth || b.z() <= kMinDepth) return false;
-  *d = project(b) - project(a);
-  *length = d->norm();
+  const Eigen::Vector2d d = project(b) - project(a);
+  *length = d.norm();
   if (!(*length > 1e-9) || !std::isfinite(*length)) return false;
-  Eigen::Matrix2d perp;  // turns by +90 deg
-  perp << 0.0, -1.0, 1.0, 0.0;
-  *normal = perp * *d / *length;
+  *normal = Eigen::Vector2d(-d.y(), d.x()) / *length;  // d turned by +90 deg
   return true;
 }
 
@@ -67,6 +65,8 @@ ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, doub
       blur_sigma_px_(blur_sigma_px),
       edge_width_px_(std::sqrt(blur_sigma_px * blur_sigma_px + 1.0)) {
   if (!extractor_) throw std::invalid_argument("ContourCost: extractor is null");
+  center_object_ = extractor_->mesh().bounding_box_center();
+  radius_m_ = extractor_->mesh().radius_about(center_object_);
   if (!(spacing_px > 0.0) || !std::isfinite(spacing_px))
     throw std::invalid_argument("ContourCost: spacing_px must be > 0, got " +
                                 std::to_string(spacing_px));
@@ -90,12 +90,9 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
 
   // Region around the object's projection at the preliminary pose (full-resolution px): the
   // bounding sphere of the mesh, plus its projected radius and 32 px on every side.
-  const Mesh& mesh = extractor_->mesh();
-  const Eigen::Vector3d center_object = mesh.bounding_box_center();
-  double radius = 0.0;
-  for (const auto& v : mesh.vertices) radius = std::max(radius, (v - center_object).norm());
+  const double radius = radius_m_;
   const PinholeCamera& camera = frame.levels[0].camera;
-  const Eigen::Vector3d center = frame.predicted_object_to_camera * center_object;
+  const Eigen::Vector3d center = frame.predicted_object_to_camera * center_object_;
   cv::Rect2d full(0, 0, camera.width(), camera.height());
   if (center.z() > radius + kMinDepth) {
     const Eigen::Vector2d c = camera.project(center);
@@ -224,9 +221,9 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
   int kept = 0;
   for (const Segment& segment : segments_) {
     const Eigen::Vector3d a = r * segment.a_object + t, b = r * segment.b_object + t;
-    Eigen::Vector2d d, normal;
+    Eigen::Vector2d normal;
     double length = 0.0;
-    if (!project_segment(a, b, project, &d, &length, &normal)) continue;
+    if (!project_segment(a, b, project, &length, &normal)) continue;
     Matrix26d normal_jacobian = Matrix26d::Zero();  // d normal / d delta
     if (derivatives) {
       const Matrix26d dd = projection_jacobian(b, center_camera, fx, fy) -
@@ -299,9 +296,9 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
     int kept = 0;
     for (std::size_t i = 0; i < segments_.size(); ++i) {
       const Segment& segment = segments_[i];
-      Eigen::Vector2d d, normal;
+      Eigen::Vector2d normal;
       double length = 0.0;
-      if (!project_segment(ends_camera[2 * i] + shift, ends_camera[2 * i + 1] + shift, project, &d,
+      if (!project_segment(ends_camera[2 * i] + shift, ends_camera[2 * i + 1] + shift, project,
                            &length, &normal))
         continue;
       for (int k = segment.first_sample; k < segment.end_sample; ++k) {

@@ -38,11 +38,8 @@ FeatureRelocalizer::FeatureRelocalizer(std::shared_ptr<const Mesh> mesh,
   orb_ = cv::ORB::create(settings_.max_features, 1.2f, 8, 15, 0, 2, cv::ORB::HARRIS_SCORE, 15,
                          settings_.fast_threshold);
   center_object_ = mesh_->bounding_box_center();
-  Eigen::Vector3d lo = mesh_->vertices.front(), hi = lo;
-  for (const auto& v : mesh_->vertices) {
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
-  }
+  const Eigen::AlignedBox3d box = mesh_->bounding_box();
+  const Eigen::Vector3d lo = box.min(), hi = box.max();
   for (int i = 0; i < 8; ++i)
     corners_object_.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
                                  i & 4 ? hi.z() : lo.z());

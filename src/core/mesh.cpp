@@ -467,14 +467,21 @@ double Mesh::diameter() const {
   return std::max(lower_bound, max_pairwise_distance(candidates));
 }
 
+Eigen::AlignedBox3d Mesh::bounding_box() const {
+  Eigen::AlignedBox3d box;  // empty
+  for (const auto& v : vertices) box.extend(v);
+  return box;
+}
+
 Eigen::Vector3d Mesh::bounding_box_center() const {
   if (vertices.empty()) return Eigen::Vector3d::Zero();
-  Eigen::Vector3d lo = vertices.front(), hi = vertices.front();
-  for (const auto& v : vertices) {
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
-  }
-  return 0.5 * (lo + hi);
+  return bounding_box().center();
+}
+
+double Mesh::radius_about(const Eigen::Vector3d& center_object) const {
+  double radius = 0.0;
+  for (const auto& v : vertices) radius = std::max(radius, (v - center_object).norm());
+  return radius;
 }
 
 Eigen::Vector3d Mesh::face_normal(int face) const {
@@ -556,14 +563,11 @@ Mesh load_mesh(const std::string& path, double scale) {
   for (const auto& c : corners)
     if (!c.allFinite()) throw mesh_error(path, "a vertex coordinate is not finite");
 
-  Eigen::Vector3d lo = corners.front(), hi = corners.front();
-  for (const auto& c : corners) {
-    lo = lo.cwiseMin(c);
-    hi = hi.cwiseMax(c);
-  }
+  Eigen::AlignedBox3d box;
+  for (const auto& c : corners) box.extend(c);
   // The bounding-box diagonal (between 1 and sqrt(3) object diameters) bounds the model's size
   // before anything depends on it: a scale of 1e300 or a mesh in the wrong unit is named here.
-  const double size = (hi - lo).norm();
+  const double size = box.diagonal().norm();
   if (!(size > 0.0)) throw mesh_error(path, "all vertices coincide");
   if (!(size >= PlausibilityLimits::kMinDiameterM && size <= PlausibilityLimits::kMaxDiameterM))
     throw mesh_error(path, "the model is " + format_number(size) +
@@ -575,7 +579,7 @@ Mesh load_mesh(const std::string& path, double scale) {
                                "0.001 for a model in millimetres)");
 
   Mesh result;
-  const std::vector<int> remap = merge_by_position(corners, lo, 1e-6 * size, result.vertices);
+  const std::vector<int> remap = merge_by_position(corners, box.min(), 1e-6 * size, result.vertices);
   // Zero-area faces (repeated or collinear corners) have no normal and no contour: dropped.
   const double min_double_area = 1e-12 * size * size;
   for (std::size_t f = 0; f < corners.size() / 3; ++f) {

@@ -53,11 +53,9 @@ ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchS
   settings_.validate();
   diameter_m_ = mesh_->diameter();
   center_object_ = mesh_->bounding_box_center();
-  box_min_object_ = box_max_object_ = mesh_->vertices.front();
-  for (const Eigen::Vector3d& vertex : mesh_->vertices) {
-    box_min_object_ = box_min_object_.cwiseMin(vertex);
-    box_max_object_ = box_max_object_.cwiseMax(vertex);
-  }
+  const Eigen::AlignedBox3d box = mesh_->bounding_box();
+  box_min_object_ = box.min();
+  box_max_object_ = box.max();
 }
 
 bool ObjectSearch::looks_grey(const cv::Mat& bgr) {

@@ -36,7 +36,7 @@ PoseRefiner::PoseRefiner(std::shared_ptr<const Mesh> mesh, const TrackerParams& 
   energy_ = std::make_unique<ContourEnergy>(extractor_, params_.contour_sample_spacing_px);
   size_m_ = mesh_->diameter();
   center_object_ = mesh_->bounding_box_center();
-  for (const auto& v : mesh_->vertices) radius_m_ = std::max(radius_m_, (v - center_object_).norm());
+  radius_m_ = mesh_->radius_about(center_object_);
   build_cues();
 }
 

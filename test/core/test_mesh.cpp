@@ -98,6 +98,20 @@ TEST(Mesh, DemoModelIsClosedTexturedAndInMetres) {
     EXPECT_NEAR(mesh.face_normal(f).norm(), 1.0, 1e-12);
 }
 
+TEST(Mesh, BoundingBoxAndBoundingSphere) {
+  kct::Mesh mesh;
+  EXPECT_TRUE(mesh.bounding_box().isEmpty());
+  mesh.vertices = {{0.0, 0.0, 0.0}, {0.1, 0.0, 0.0}, {0.0, 0.2, 0.0}, {0.0, 0.0, 0.3}};
+  mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  const Eigen::AlignedBox3d box = mesh.bounding_box();
+  EXPECT_LT((box.min() - Eigen::Vector3d(0, 0, 0)).norm(), 1e-12);
+  EXPECT_LT((box.max() - Eigen::Vector3d(0.1, 0.2, 0.3)).norm(), 1e-12);
+  EXPECT_LT((mesh.bounding_box_center() - Eigen::Vector3d(0.05, 0.1, 0.15)).norm(), 1e-12);
+  // Every vertex of this mesh is a box corner: all are half a diagonal from the centre.
+  EXPECT_NEAR(mesh.radius_about(mesh.bounding_box_center()), 0.5 * std::sqrt(0.01 + 0.04 + 0.09), 1e-12);
+  EXPECT_NEAR(mesh.radius_about(Eigen::Vector3d::Zero()), 0.3, 1e-12);
+}
+
 TEST(Mesh, ScaleFactorMultipliesCoordinates) {
   const kct::Mesh metres = kct::load_mesh(kDemoModel);
   const kct::Mesh millimetres = kct::load_mesh(kDemoModel, 1000.0);

@@ -88,6 +88,8 @@ class ContourCost : public PoseCost {
   double spacing_px_;
   double blur_sigma_px_;
   double edge_width_px_;
+  Eigen::Vector3d center_object_;  ///< the mesh's bounding-box centre, object frame, m
+  double radius_m_ = 0.0;          ///< the mesh's bounding-sphere radius about it, m
   std::unique_ptr<WorkerThreads> workers_;  ///< num_threads threads, the caller's included
   const PoseCostFrame* frame_ = nullptr;
   std::vector<LevelImages> levels_;

@@ -30,8 +30,13 @@ struct Mesh {
   bool has_texture() const { return !texture.empty() && corner_uvs.size() == faces.size() * 3; }
   /// Largest distance between two vertices (the paper's object size / diameter d), metres.
   double diameter() const;
+  /// Axis-aligned bounding box of the vertices, object frame, metres (empty without vertices).
+  Eigen::AlignedBox3d bounding_box() const;
   /// Centre of the axis-aligned bounding box, object frame, metres.
   Eigen::Vector3d bounding_box_center() const;
+  /// Largest distance of a vertex from `center_object`, metres: the radius of the bounding
+  /// sphere about that centre.
+  double radius_about(const Eigen::Vector3d& center_object) const;
   /// Unit outward normal of a face (from its CCW winding).
   Eigen::Vector3d face_normal(int face) const;
   /// Edges shared by exactly two faces (boundary and non-manifold edges are skipped).
