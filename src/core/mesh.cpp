@@ -434,8 +434,7 @@ double Mesh::diameter() const {
   if (vertices.size() < 2) return 0.0;
   if (vertices.size() <= 2000) return max_pairwise_distance(vertices);
   const Eigen::Vector3d center = bounding_box_center();
-  double radius = 0.0;
-  for (const auto& v : vertices) radius = std::max(radius, (v - center).norm());
+  const double radius = radius_about(center);
 
   constexpr int kDirections = 1024;
   std::vector<int> extreme_ids;

@@ -21,8 +21,7 @@ RegionCost::RegionCost(std::shared_ptr<const ContourExtractor> extractor,
     throw std::invalid_argument("RegionCost: learning_rate must be in (0, 1], got " +
                                 std::to_string(learning_rate));
   const Mesh& mesh = extractor->mesh();
-  const Eigen::Vector3d center = mesh.bounding_box_center();
-  for (const auto& v : mesh.vertices) radius_m_ = std::max(radius_m_, (v - center).norm());
+  radius_m_ = mesh.radius_about(mesh.bounding_box_center());
 }
 
 void RegionCost::begin_frame(const PoseCostFrame& frame) {

@@ -329,8 +329,7 @@ cv::Mat Renderer::render_face_index_orthographic(const Eigen::Vector3d& view_dir
   const Eigen::Vector3d y_axis = z_axis.cross(x_axis);
 
   const Eigen::Vector3d center = mesh.bounding_box_center();
-  double radius = 0.0;
-  for (const auto& v : mesh.vertices) radius = std::max(radius, (v - center).norm());
+  double radius = mesh.radius_about(center);
   if (!(radius > 0.0)) radius = 1.0;
   // [-radius, radius] covers pixels [-0.5, resolution - 0.5].
   const double scale = resolution_px / (2.0 * radius);
