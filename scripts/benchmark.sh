@@ -2,12 +2,13 @@
 # Benchmark: installs and builds (like demo.sh), generates the missing models and sequences
 # under data/benchmark (cached, deterministic), tracks them with each configuration and writes
 # docs/benchmarks.md (+ docs/benchmarks/<section>.md and the success-curve PNGs).
-#   scripts/benchmark.sh [--section hard|hard2|real|opt ...] [--quick] [--preset NAME ...]
+#   scripts/benchmark.sh [--section hard|hard2|noise|real|opt ...] [--quick] [--preset NAME ...]
 #                        [--variant LABEL:PRESET:param=value,...] [--hard-frames N] [--reuse LABEL]
 #                        [--objects can,chest,...] [--frames N] [--track-frames N]
 #   sections (default: all): hard (hand-held, clutter, occlusion, leaving the image, lighting,
 #     sensor effects; 4 objects x 6 conditions x 80 frames), hard2 (the same with other seeds and
-#     backgrounds: a change is judged on both), real (ViSP's sequences from
+#     backgrounds: a change is judged on both), noise (realtime and klt_only on both hard sets
+#     from 5 slightly perturbed initial poses: how much of a difference is chance), real (ViSP's sequences from
 #     visp-images-data), opt (OPT-style groups; --objects/--frames/--track-frames apply to it)
 #   --quick: part of each section; run times are in docs/benchmarks.md
 #   default configurations: the presets realtime, paper and klt_only that exist, plus the
@@ -22,7 +23,7 @@ while [ $# -gt 0 ]; do
     --quick) ARGS+=(--quick); shift ;;
     --preset) [ $# -ge 2 ] || { echo "benchmark: --preset needs a name" >&2; exit 2; }
               ARGS+=(--preset "$2"); shift 2 ;;
-    --section) [ $# -ge 2 ] || { echo "benchmark: --section needs hard, hard2, real or opt" >&2; exit 2; }
+    --section) [ $# -ge 2 ] || { echo "benchmark: --section needs hard, hard2, noise, real or opt" >&2; exit 2; }
                ARGS+=(--section "$2"); shift 2 ;;
     --variant) [ $# -ge 2 ] || { echo "benchmark: --variant needs LABEL:PRESET:param=value,..." >&2; exit 2; }
                ARGS+=(--variant "$2"); shift 2 ;;
