@@ -556,7 +556,8 @@ def perturbed_sequence(data, source, set_name, obj, cond, draw):
 
 
 def run_noise(args, configs, runner, data, docs_dir, tmp):
-    chosen = [c for c in configs if c[0] in NOISE_PRESETS]
+    # NOISE_PRESETS and every --variant: a candidate change is judged against its own spread.
+    chosen = [c for c in configs if c[0] in NOISE_PRESETS or c in args.variant]
     start = datetime.datetime.now(datetime.timezone.utc)
     load_start, t0 = os.getloadavg()[0], time.time()
     sets = ["hard", "hard2"]
@@ -1278,7 +1279,7 @@ def main():
                        for r in rows], f, indent=1)
         for c in configs:
             if not any(r["preset"] == c[0] for r in rows):
-                continue  # not tracked in this section (noise: NOISE_PRESETS only)
+                continue  # not tracked in this section (noise: NOISE_PRESETS and --variant only)
             summary.append("%s %-22s AUC %s (%.1f min for the section)" % (
                 s, c[0], fmt(weighted_auc([r for r in rows if r["preset"] == c[0]])), (time.time() - ts) / 60))
     write_page(repo, docs_dir)

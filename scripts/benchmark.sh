@@ -7,8 +7,9 @@
 #                        [--objects can,chest,...] [--frames N] [--track-frames N]
 #   sections (default: all): hard (hand-held, clutter, occlusion, leaving the image, lighting,
 #     sensor effects; 4 objects x 6 conditions x 80 frames), hard2 (the same with other seeds and
-#     backgrounds: a change is judged on both), noise (realtime and klt_only on both hard sets
-#     from 5 slightly perturbed initial poses: how much of a difference is chance), real (ViSP's sequences from
+#     backgrounds: a change is judged on both), noise (realtime, klt_only and each --variant on
+#     both hard sets from 5 slightly perturbed initial poses: how much of a difference is
+#     chance), real (ViSP's sequences from
 #     visp-images-data), opt (OPT-style groups; --objects/--frames/--track-frames apply to it)
 #   --quick: part of each section; run times are in docs/benchmarks.md
 #   default configurations: the presets realtime, paper and klt_only that exist, plus the
