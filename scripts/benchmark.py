@@ -330,6 +330,8 @@ def header_lines(title, args, start, duration_s, gen_s, load_start, load_end, ex
         origins = []
         for label in args.reuse:
             code = os.path.join(args.data_results, section, label, "CODE")
+            if section == "noise":
+                code = os.path.join(args.data_results, section, label + "_draw0", "CODE")
             origins.append("%s (%s)" % (label, open(code).read().strip() if os.path.exists(code) else "?"))
         L.append("- **Reused results** (`--reuse`: tracked by an earlier run; its code and date): %s"
                  % "; ".join(origins))
@@ -570,6 +572,8 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
             for (s, o, c), source in folders.items():
                 folder = perturbed_sequence(data, source, s, o, c, draw)
                 label = "%s_draw%d" % (config[0], draw)
+                if config[0] in runner.reuse:  # --reuse realtime: every draw of it
+                    runner.reuse.add(label)
                 r = runner.track("noise", (label, config[1], config[2]), "%s/%s/%s" % (s, o, c), folder,
                                  os.path.join(data, "models", HARD_OBJECTS[o]["model"] + ".obj"))
                 if not r:
