@@ -90,13 +90,12 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
 
   // Region around the object's projection at the preliminary pose (full-resolution px): the
   // bounding sphere of the mesh, plus its projected radius and 32 px on every side.
-  const double radius = radius_m_;
   const PinholeCamera& camera = frame.levels[0].camera;
   const Eigen::Vector3d center = frame.predicted_object_to_camera * center_object_;
   cv::Rect2d full(0, 0, camera.width(), camera.height());
-  if (center.z() > radius + kMinDepth) {
+  if (center.z() > radius_m_ + kMinDepth) {
     const Eigen::Vector2d c = camera.project(center);
-    const double r = std::max(camera.fx(), camera.fy()) * radius / (center.z() - radius);
+    const double r = std::max(camera.fx(), camera.fy()) * radius_m_ / (center.z() - radius_m_);
     const double half = 2.0 * r + 32.0;
     full = cv::Rect2d(c.x() - half, c.y() - half, 2 * half, 2 * half) &
            cv::Rect2d(0, 0, camera.width(), camera.height());

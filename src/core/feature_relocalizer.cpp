@@ -39,10 +39,8 @@ FeatureRelocalizer::FeatureRelocalizer(std::shared_ptr<const Mesh> mesh,
                          settings_.fast_threshold);
   center_object_ = mesh_->bounding_box_center();
   const Eigen::AlignedBox3d box = mesh_->bounding_box();
-  const Eigen::Vector3d lo = box.min(), hi = box.max();
   for (int i = 0; i < 8; ++i)
-    corners_object_.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
-                                 i & 4 ? hi.z() : lo.z());
+    corners_object_.push_back(box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(i)));
 }
 
 bool FeatureRelocalizer::wants_keyframe(const Pose& object_to_camera) const {

@@ -53,9 +53,7 @@ ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchS
   settings_.validate();
   diameter_m_ = mesh_->diameter();
   center_object_ = mesh_->bounding_box_center();
-  const Eigen::AlignedBox3d box = mesh_->bounding_box();
-  box_min_object_ = box.min();
-  box_max_object_ = box.max();
+  box_object_ = mesh_->bounding_box();
 }
 
 bool ObjectSearch::looks_grey(const cv::Mat& bgr) {
@@ -134,10 +132,8 @@ cv::Rect ObjectSearch::silhouette_canvas(const Pose& object_to_camera,
   const cv::Rect limit(-width, -height, 3 * width, 3 * height);
   double u_min = 1e300, u_max = -1e300, v_min = 1e300, v_max = -1e300;
   for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d point_object((corner & 1) ? box_max_object_.x() : box_min_object_.x(),
-                                       (corner & 2) ? box_max_object_.y() : box_min_object_.y(),
-                                       (corner & 4) ? box_max_object_.z() : box_min_object_.z());
-    const Eigen::Vector3d point_camera = object_to_camera * point_object;
+    const Eigen::Vector3d point_camera =
+        object_to_camera * box_object_.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
     if (!(point_camera.z() > 1e-3)) return limit;  // the box crosses the camera plane
     const Eigen::Vector2d pixel = working_camera.project(point_camera);
     u_min = std::min(u_min, pixel.x());

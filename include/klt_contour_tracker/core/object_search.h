@@ -100,8 +100,7 @@ class ObjectSearch {
   ColorHistograms histograms_;
   double diameter_m_ = 0.0;
   Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d box_min_object_ = Eigen::Vector3d::Zero();  ///< the mesh's bounding box
-  Eigen::Vector3d box_max_object_ = Eigen::Vector3d::Zero();
+  Eigen::AlignedBox3d box_object_;  ///< the mesh's bounding box
 };
 
 }  // namespace kct
