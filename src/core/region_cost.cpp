@@ -46,7 +46,11 @@ void RegionCost::linearize(const Pose& object_to_camera, int level) {
         camera.fx() / depth * (motion.tail<3>().norm() + motion.head<3>().norm() * radius_m_);
     if (moved_px < 0.25 * scale) return;
   }
-  cue_.linearize(object_to_camera, camera, scale);
+  // The silhouette at this pose keeps the lines on the outer outline (RegionCue::linearize).
+  RenderOptions options;
+  options.draw_color = false;
+  cue_.linearize(object_to_camera, camera, scale,
+                 renderer_.render(object_to_camera, camera, options).mask());
   lines_level_ = level;
   lines_pose_ = object_to_camera;
 }

@@ -10,6 +10,9 @@ namespace kct {
 namespace {
 
 constexpr double kMinDepth = 1e-6;  // metres
+// Distance from a line's centre at which the rendered silhouette is trusted, px: past the
+// rasterization's half-pixel uncertainty of where the edge falls.
+constexpr double kProbePx = 1.5;
 
 /// The vertex of `face` that is neither end of the edge (v0, v1); -1 if none.
 int opposite_vertex(const Mesh& mesh, int face, int v0, int v1) {
@@ -72,10 +75,20 @@ double RegionCue::posterior_at(double x, double y) const {
   return top + fy * (bottom - top);
 }
 
-void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& camera, double scale) {
+void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& camera, double scale,
+                          const cv::Mat& silhouette) {
   if (!histograms_) throw std::logic_error("RegionCue::linearize: set_frame() was not called");
   if (!(scale >= 1.0) || !std::isfinite(scale))
     throw std::invalid_argument("RegionCue::linearize: scale must be >= 1");
+  if (!silhouette.empty() &&
+      (silhouette.type() != CV_8UC1 || silhouette.cols != camera.width() ||
+       silhouette.rows != camera.height()))
+    throw std::invalid_argument("RegionCue::linearize: silhouette must be CV_8UC1 of the camera's size");
+  const auto on_object = [&silhouette](const Eigen::Vector2d& p) {
+    const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+    return x >= 0 && y >= 0 && x < silhouette.cols && y < silhouette.rows &&
+           silhouette.at<uchar>(y, x) != 0;
+  };
   camera_ = camera;
   scale_ = scale;
   lines_.clear();
@@ -123,20 +136,31 @@ void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& cam
       if (point_camera.z() <= kMinDepth) continue;
       line.centre_px = camera.project(point_camera);
       line.normal = normal;
-      place_line(line, scale);
+      if (!silhouette.empty() && on_object(line.centre_px + kProbePx * normal)) continue;
+      place_line(line, scale, silhouette);
       lines_.push_back(line);
     }
   }
 }
 
-void RegionCue::place_line(Line& line, double scale) {
+void RegionCue::place_line(Line& line, double scale, const cv::Mat& silhouette) {
   const int half = settings_.line_half_length_px;
-  contrast_.clear();
+  contrast_.assign(2 * half, 0.0);
   bool informative = false;
-  for (int j = -half; j < half; ++j) {
-    const Eigen::Vector2d p = line.centre_px + (j + 0.5) * scale * line.normal;
-    contrast_.push_back(2.0 * posterior_at(p.x(), p.y()) - 1.0);
-    informative = informative || contrast_.back() != 0.0;
+  // Outwards from the centre (j >= 0) until the object is met again, inwards (j < 0) until it
+  // is left; pixels beyond stay 0 (unknown).
+  for (const int direction : {1, -1}) {
+    for (int j = direction > 0 ? 0 : -1; j >= -half && j < half; j += direction) {
+      const Eigen::Vector2d p = line.centre_px + (j + 0.5) * scale * line.normal;
+      // Within kProbePx of the centre the rasterized silhouette's edge is uncertain.
+      if (!silhouette.empty() && std::abs(j + 0.5) * scale > kProbePx) {
+        const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+        const bool inside_image = x >= 0 && y >= 0 && x < silhouette.cols && y < silhouette.rows;
+        if (inside_image && (silhouette.at<uchar>(y, x) != 0) != (direction < 0)) break;
+      }
+      contrast_[j + half] = 2.0 * posterior_at(p.x(), p.y()) - 1.0;
+      informative = informative || contrast_[j + half] != 0.0;
+    }
   }
   line.mean_px = 0.0;
   line.weight = 0.0;
@@ -197,8 +221,9 @@ double RegionCue::evaluate(const Pose& object_to_camera, Vector6d* gradient,
   return sum * norm;
 }
 
-double RegionCue::cost_at(const Pose& object_to_camera, const PinholeCamera& camera, double scale) {
-  linearize(object_to_camera, camera, scale);
+double RegionCue::cost_at(const Pose& object_to_camera, const PinholeCamera& camera, double scale,
+                          const cv::Mat& silhouette) {
+  linearize(object_to_camera, camera, scale, silhouette);
   return evaluate(object_to_camera, nullptr, nullptr);
 }
 

@@ -179,6 +179,49 @@ TEST_F(RegionCueTest, LinesOutsideTheImageWeighNothing) {
   EXPECT_EQ(gradient.norm(), 0.0);
 }
 
+/// A small box standing in front of a large one of the same colour: the small box's outline
+/// lies inside the object's silhouette, object on both sides (as an arm before a body).
+TEST(RegionCue, OnlyTheOuterOutlineCountsWithASilhouette) {
+  auto mesh = std::make_shared<Mesh>();
+  test::append_box(*mesh, {-0.05, -0.04, -0.03}, {0.05, 0.04, 0.0});     // back
+  test::append_box(*mesh, {-0.015, -0.015, -0.06}, {0.015, 0.015, -0.03});  // front
+  mesh->base_color = cv::Vec3b(40, 60, 200);
+  const auto extractor = std::make_shared<ContourExtractor>(
+      mesh, VisibilityTable::build(*mesh, 3, 128, ""), 45.0);
+  const PinholeCamera camera = test::make_camera();
+  const Pose truth = test::make_pose(0.4, 10, -10, 5);  // the front box faces the camera
+  const Renderer renderer(mesh);
+  const cv::Mat background(camera.size(), CV_8UC3, cv::Scalar(200, 120, 40));
+  const cv::Mat frame = test::render_frame(renderer, camera, truth, background, 3.0);
+  ColorHistograms histograms;
+  ASSERT_TRUE(histograms.learn(frame, renderer.render(truth, camera).mask(), 10, 1.0));
+  const Eigen::Vector3d center = mesh->bounding_box_center();
+  const auto silhouette = [&](const Pose& pose) { return renderer.render(pose, camera).mask(); };
+
+  RegionCue cue(extractor, RegionCueSettings{});
+  cue.set_frame(frame, histograms, center);
+  // Without the silhouette the front box's all-object lines each claim, confidently, that the
+  // outline lies a line's length further out: far from the minimum at the truth.
+  const double biased = cue.cost_at(truth, camera);
+  const int all_lines = cue.line_count();
+  EXPECT_GT(biased, 1.0);
+  const double at_truth = cue.cost_at(truth, camera, 1.0, silhouette(truth));
+  EXPECT_LT(cue.line_count(), all_lines);
+  EXPECT_GT(cue.line_count(), 40);
+  EXPECT_GE(at_truth, 0.0);
+  EXPECT_LT(at_truth, 0.1);
+  // Every single-parameter offset (3 deg, 4 mm) costs more.
+  for (int i = 0; i < 6; ++i)
+    for (double sign : {-1.0, 1.0}) {
+      Vector6d x = Vector6d::Zero();
+      x[i] = sign * (i < 3 ? 3.0 * M_PI / 180.0 : 0.004);
+      const Pose moved = apply_increment(truth, x, center);
+      EXPECT_GT(cue.cost_at(moved, camera, 1.0, silhouette(moved)), at_truth + 0.05)
+          << "parameter " << i;
+    }
+  EXPECT_THROW(cue.linearize(truth, camera, 1.0, cv::Mat(10, 10, CV_8UC1)), std::invalid_argument);
+}
+
 TEST(RegionCue, RejectsBadSettings) {
   auto mesh = std::make_shared<const Mesh>(test::make_box(0.1, 0.1, 0.1, false));
   auto extractor = std::make_shared<const ContourExtractor>(mesh, nullptr, 45.0);

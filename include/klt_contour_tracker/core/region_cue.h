@@ -42,7 +42,8 @@ struct RegionCueSettings {
 /// h_f(s) = 1/2 - alpha_h tanh(s / (2 s_h scale)) (probability that offset s lies on the
 /// object), the likelihood that the outline crosses the line at offset d is
 ///   p_i(d) ~ prod_j [h_f(s_j - d) P_ij + (1 - h_f(s_j - d)) (1 - P_ij)]
-/// over d = k scale, |k| < L (SRT3D Eq. 7-9). Its mean mu_i and variance sigma_i^2 (at least
+/// over d = k scale, |k| < L (SRT3D Eq. 7-9); with a silhouette, only lines on the outer outline,
+/// each cut where it meets another part of the object or leaves a thin one (see linearize()). Its mean mu_i and variance sigma_i^2 (at least
 /// (scale / 2)^2) are held fixed until the next linearize(). evaluate() projects X_i at the
 /// pose, takes its shift delta_i = n_i . (pi(X_i) - c_i) along the line and returns
 ///   cost = (1 / N) sum_i 0.5 w_i (delta_i - mu_i)^2,  w_i = 1 / sigma_i^2 - 1 / sigma_u^2,
@@ -73,8 +74,15 @@ class RegionCue {
 
   /// Places the correspondence lines at `object_to_camera` (camera: full-resolution
   /// intrinsics of the frame); `scale` >= 1 stretches the lines, spacing and step (coarse
-  /// levels: 2, 4). Throws std::logic_error before set_frame().
-  void linearize(const Pose& object_to_camera, const PinholeCamera& camera, double scale = 1.0);
+  /// levels: 2, 4). `silhouette` (CV_8UC1 of the camera's size, non-zero on the object rendered
+  /// at this pose; empty = no check) keeps only lines on the outer outline: a Contour edge
+  /// whose outward side is the object again (a part in front of another, e.g. an arm before the
+  /// body, or a back edge the visibility table let through) has no background to separate, and
+  /// its all-foreground line would confidently pull the outline outwards by the line's length.
+  /// Throws std::logic_error before set_frame(), std::invalid_argument for a silhouette of
+  /// another size or type.
+  void linearize(const Pose& object_to_camera, const PinholeCamera& camera, double scale = 1.0,
+                 const cv::Mat& silhouette = cv::Mat());
 
   /// Cost at `object_to_camera` with the lines of the last linearize(); when non-null, ADDS
   /// its gradient and Hessian approximation w.r.t. the increment at 0 to `gradient`/`hessian`.
@@ -82,7 +90,8 @@ class RegionCue {
 
   /// linearize() then evaluate() at the same pose (no gradient): a pure function of the pose,
   /// 0.5 w_i mu_i^2 averaged: how far the colours say the outline should move.
-  double cost_at(const Pose& object_to_camera, const PinholeCamera& camera, double scale = 1.0);
+  double cost_at(const Pose& object_to_camera, const PinholeCamera& camera, double scale = 1.0,
+                 const cv::Mat& silhouette = cv::Mat());
 
   /// Number of lines of the last linearize() (in and out of the image).
   int line_count() const { return static_cast<int>(lines_.size()); }
@@ -96,8 +105,10 @@ class RegionCue {
     double weight = 0.0;   // w_i, 1/px^2
   };
   double posterior_at(double x, double y) const;
-  /// Reads the line's posteriors and sets its mean and weight.
-  void place_line(Line& line, double scale);
+  /// Reads the line's posteriors and sets its mean and weight. With a silhouette, the line
+  /// ends where it meets another part of the object (outwards) or leaves it (inwards): beyond,
+  /// its pixels count as unknown.
+  void place_line(Line& line, double scale, const cv::Mat& silhouette);
   float pixel_posterior(int x, int y) const;
 
   std::shared_ptr<const ContourExtractor> extractor_;
