@@ -24,6 +24,7 @@ import math
 import os
 import platform
 import random
+import shutil
 import shlex
 import subprocess
 import sys
@@ -32,7 +33,7 @@ import zlib
 
 PHOTOS = "/usr/share/doc/opencv-doc/examples/data"
 VISP = "/usr/share/visp-images-data/ViSP-images"
-SECTIONS = ["hard", "hard2", "noise", "real", "opt"]  # page order: the hard sections first
+SECTIONS = ["hard", "hard2", "photo", "noise", "real", "opt"]  # page order: the hard sections first
 
 # ---------------------------------------------------------------------------------------------
 # Configurations: a label, a preset and parameter overrides. Add a cue ablation by appending to
@@ -493,6 +494,9 @@ HARD_SETS = {
 }
 
 
+SECTION_TITLES = dict({k: v[2] for k, v in HARD_SETS.items()}, photo="Photo section (path-traced)")
+
+
 def hard_sequence(data, obj, cond, frames, set_name="hard"):
     spec = HARD_OBJECTS[obj]
     tag, background_index, _ = HARD_SETS[set_name]
@@ -504,6 +508,58 @@ def hard_sequence(data, obj, cond, frames, set_name="hard"):
            "--background", os.path.join(PHOTOS, backgrounds[background_index(seed) % len(backgrounds)])]
     cmd += HARD_BASE + spec["render"] + HARD_CONDITIONS[cond][1]
     return cached_run(cmd, folder, "rendering %s/%s/%s" % (set_name, obj, cond))
+
+
+# ---------------------------------------------------------------------------------------------
+# Photo section: the hard section's trajectories path-traced by Blender's Cycles
+# ---------------------------------------------------------------------------------------------
+# scripts/photoreal_render.py re-renders a hard sequence's trajectory (its pose.txt, K.txt and
+# visible.txt are the ground truth): soft shadows, inter-reflections, true motion blur, depth of
+# field, sampling noise, a camera's tone curve, clutter in the object's own texture or colour.
+# condition: description, source (hard set, condition, typical mm / deg a frame, jerk
+# probability; None = that hard sequence as it is), render options.
+PHOTO_CONDITIONS = {
+    "handheld": ("hand-held in clutter (10 things, a third in the object's own texture or colour)",
+                 ("hard", "handheld", None), ["--clutter", "10"]),
+    "slow": ("slow hand-held motion (1.5 mm and 0.5 deg a frame, no jerks), clutter",
+             ("hard", "slow", ("1.5", "0.5", "0")), ["--clutter", "6"]),
+    "light": ("hand-held, a key light that sweeps around and dims, clutter",
+              ("hard2", "handheld", None), ["--clutter", "6", "--moving-light"]),
+}
+PHOTO_SAMPLES = 10  # path-tracing samples per pixel: a visibly grainy frame, like a webcam's
+PHOTO_QUICK = dict(objects=["can", "toy"], conditions=["handheld"])
+
+
+def photo_source(data, obj, cond):
+    """The generated sequence whose trajectory and ground truth a photo sequence re-renders."""
+    set_name, source_cond, slow = PHOTO_CONDITIONS[cond][1]
+    if slow is None:
+        return hard_sequence(data, obj, source_cond, HARD_FRAMES, set_name)
+    # A trajectory the hard section has not: slow and smooth (generate_sequence's own frames are
+    # only a by-product here).
+    spec = HARD_OBJECTS[obj]
+    seed = zlib.crc32(("photo/%s/%s" % (obj, cond)).encode()) % 100000 + 1
+    folder = os.path.join(data, "photo_source", obj, cond)
+    base = list(HARD_BASE)
+    for flag, value in zip(("--typical-translation-mm", "--typical-rotation-deg", "--jerk-probability"), slow):
+        base[base.index(flag) + 1] = value
+    cmd = ["rosrun", "klt_contour_tracker", "generate_sequence", "--model", ensure_model(data, spec["model"]),
+           "--output-dir", folder, "--frames", HARD_FRAMES, "--seed", seed,
+           "--background", os.path.join(PHOTOS, BACKGROUNDS[seed % len(BACKGROUNDS)])] + base + spec["render"]
+    return cached_run(cmd, folder, "trajectory photo_source/%s/%s" % (obj, cond))
+
+
+def photo_sequence(data, obj, cond, repo):
+    source = photo_source(data, obj, cond)
+    seed = zlib.crc32(("photo/%s/%s" % (obj, cond)).encode()) % 100000 + 1
+    folder = os.path.join(data, "photo", obj, cond)
+    clutter = HARD_BACKGROUNDS["clutter"]
+    cmd = ["blender", "-b", "--factory-startup", "-noaudio", "-P", os.path.join(repo, "scripts", "photoreal_render.py"),
+           "--", "--source", source, "--model", os.path.join(data, "models", HARD_OBJECTS[obj]["model"] + ".obj"),
+           "--background", os.path.join(PHOTOS, BACKGROUNDS[(seed // 3) % len(BACKGROUNDS)]),
+           "--clutter-texture", os.path.join(PHOTOS, clutter[seed % len(clutter)]),
+           "--output", folder, "--samples", PHOTO_SAMPLES, "--seed", seed] + PHOTO_CONDITIONS[cond][2]
+    return cached_run(cmd, folder, "path-tracing photo/%s/%s (Blender Cycles, ~4 min)" % (obj, cond))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -587,13 +643,15 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
                 [r for r in rows if r["preset"] == config[0] and r["draw"] == draw]))))
     duration, load_end = time.time() - t0, os.getloadavg()[0]
 
-    def spread(values):
+    def spread(values, with_range=True):
+        """mean +- sample sd, and the range unless with_range is False."""
         values = [v for v in values if v is not None]
         if not values:
             return "-"
         mean = sum(values) / len(values)
         sd = (sum((v - mean) ** 2 for v in values) / max(1, len(values) - 1)) ** 0.5
-        return "%.2f +- %.2f (%.2f .. %.2f)" % (mean, sd, min(values), max(values))
+        text = "%.2f +- %.2f" % (mean, sd)
+        return text + (" (%.2f .. %.2f)" % (min(values), max(values)) if with_range else "")
 
     L = header_lines("Noise section", args, start, duration, gen_s, load_start, load_end, [
         "- **Mode:** %s on both hard sets (48 sequences x %d frames), %d draws of the initial pose each "
@@ -632,7 +690,7 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
                 b = weighted_auc([r for r in rows if r["preset"] == reference[0] and r["draw"] == d])
                 diffs.append(None if a is None or b is None else a - b)
             L.append("| %s | %s | %s |" % (c[0], " | ".join("%+.2f" % x if x is not None else "-" for x in diffs),
-                                         spread(diffs).split(" (")[0]))
+                                         spread(diffs, with_range=False)))
     L.append("\n### Spread per condition (both sets; mean +- sd over the draws)\n")
     L.append("| preset | " + " | ".join(conditions) + " |")
     L.append("|---|" + "---|" * len(conditions))
@@ -640,7 +698,7 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
         cells = []
         for cond in conditions:
             sel = [r for r in rows if r["preset"] == c[0] and r["condition"] == cond]
-            cells.append(spread([weighted_auc([r for r in sel if r["draw"] == d]) for d in range(NOISE_DRAWS)]).split(" (")[0])
+            cells.append(spread([weighted_auc([r for r in sel if r["draw"] == d]) for d in range(NOISE_DRAWS)], with_range=False))
         L.append("| %s | %s |" % (c[0], " | ".join(cells)))
     L.append("\n### Spread of single sequences\n")
     L.append("Standard deviation of a sequence's AUC over the draws: median and largest over the 48 sequences.\n")
@@ -661,13 +719,50 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
     return L, rows
 
 
-def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
-    objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
-    conditions = HARD_QUICK["conditions"] if args.quick else list(HARD_CONDITIONS)
+HARD_DESCRIPTION = (
+    "Rendered by `generate_sequence`'s scene render (CPU rasterizer), 640x480, fx = 525 px, "
+    "30 fps. Every sequence: hand-held motion (a damped random walk of the velocity with random "
+    "jerks (5 % of the frames), at most 30 mm and 8 deg a frame; steady motion 5 mm and 1.5 deg per axis and frame "
+    "(standard deviation)), Blinn-Phong "
+    "highlights, cast shadows (shadow map) on the object, the distractors and the wall carrying "
+    "a real photograph, motion blur over a 1/60 s shutter (6 sub-frame renders along the "
+    "trajectory), Gaussian noise (sigma 3) and JPEG (quality 85). The conditions add:\n")
+PHOTO_DESCRIPTION = (
+    "Path-traced by Blender's Cycles on the CPU (`scripts/photoreal_render.py`, %d samples per pixel, "
+    "no denoising), 640x480, fx = 525 px, 30 fps, along the trajectories (and with the ground truth) "
+    "of generated sequences: the object (its texture or colour, glossy) in front of a diffusely lit "
+    "real photograph, with clutter between them (boxes, cylinders, spheres; a third wearing the "
+    "object's own texture or colour, a third another photograph), an area key light and a dim fill, "
+    "soft shadows on the clutter and the photograph, inter-reflections, true motion blur over a "
+    "1/60 s shutter, depth of field (f/8, focused on the median depth), sampling noise, a camera's "
+    "filmic tone curve and JPEG (quality 90). Nothing of it is what the tracker was tuned on. "
+    "The conditions:\n" % PHOTO_SAMPLES)
+
+
+def run_photo(args, configs, runner, data, docs_dir, tmp):
+    if shutil.which("blender") is None:
+        return ["## Photo section (path-traced)\n", "Not run: `blender` is missing (Debian package blender).\n"], []
+    objects = PHOTO_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
+    conditions = PHOTO_QUICK["conditions"] if args.quick else list(PHOTO_CONDITIONS)
+    folders = {(o, c): photo_sequence(data, o, c, args.repo) for o in objects for c in conditions}
+    return run_hard(args, configs, runner, data, docs_dir, tmp, set_name="photo", folders=folders,
+                    condition_titles={c: (PHOTO_CONDITIONS[c][0], PHOTO_CONDITIONS[c][2]) for c in conditions})
+
+
+def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folders=None, condition_titles=None):
+    """The hard sections (and the photo section, given its folders and condition titles)."""
+    condition_titles = condition_titles or HARD_CONDITIONS
     frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or HARD_FRAMES)
     start = datetime.datetime.now(datetime.timezone.utc)
     load_start, t0 = os.getloadavg()[0], time.time()
-    folders = {(o, c): hard_sequence(data, o, c, frames, set_name) for o in objects for c in conditions}
+    if folders is None:
+        objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
+        conditions = HARD_QUICK["conditions"] if args.quick else list(HARD_CONDITIONS)
+        folders = {(o, c): hard_sequence(data, o, c, frames, set_name) for o in objects for c in conditions}
+    else:
+        objects = list(dict.fromkeys(o for o, _ in folders))
+        conditions = list(dict.fromkeys(c for _, c in folders))
+        frames = HARD_FRAMES
     gen_s = time.time() - t0
     rows = []
     for config in configs:
@@ -694,19 +789,13 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
     def sel(**kw):
         return [r for r in rows if all(r[k] == v for k, v in kw.items())]
     labels = [c[0] for c in configs]
-    L = header_lines(HARD_SETS[set_name][2], args, start, duration, gen_s, load_start, load_end, [
+    L = header_lines(SECTION_TITLES[set_name], args, start, duration, gen_s, load_start, load_end, [
         "- **Mode:** %s (%d objects x %d conditions x %d frames; tracked frames per sequence: %s)" % (
             "quick" if args.quick else "full", len(objects), len(conditions), frames,
             ", ".join("%s %d" % (c[0], min(HARD_TRACK_FRAMES.get(c[1], frames), frames)) for c in configs))])
-    L.append("Rendered by `generate_sequence`'s scene render (CPU rasterizer), 640x480, fx = 525 px, "
-             "30 fps. Every sequence: hand-held motion (a damped random walk of the velocity with random "
-             "jerks (5 % of the frames), at most 30 mm and 8 deg a frame; steady motion 5 mm and 1.5 deg per axis and frame "
-             "(standard deviation)), Blinn-Phong "
-             "highlights, cast shadows (shadow map) on the object, the distractors and the wall carrying "
-             "a real photograph, motion blur over a 1/60 s shutter (6 sub-frame renders along the "
-             "trajectory), Gaussian noise (sigma 3) and JPEG (quality 85). The conditions add:\n")
+    L.append(PHOTO_DESCRIPTION if set_name == "photo" else HARD_DESCRIPTION)
     for c in conditions:
-        L.append("- `%s`: %s (`%s`)" % (c, HARD_CONDITIONS[c][0], " ".join(HARD_CONDITIONS[c][1]) or "nothing more"))
+        L.append("- `%s`: %s (`%s`)" % (c, condition_titles[c][0], " ".join(condition_titles[c][1]) or "nothing more"))
     L.append("")
     L.append("Objects: %s. AUC of 20 over the frames where at least %d %% of the object's silhouette is "
              "in the image and not occluded (`visible.txt` of each sequence).\n" % (
@@ -750,7 +839,7 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
     keys = session_counts(rows)
     if keys:
         L.append("### Losses and re-acquisitions (tracking session)\n")
-        leave_args = HARD_CONDITIONS["leave"][1]
+        leave_args = condition_titles.get("leave", HARD_CONDITIONS["leave"])[1]
         L.append("A loss: the session's state goes from tracking to lost; re-acquired: it tracks again "
                  "before the sequence ends; *within %d frames*: counted from the loss, so the frames the "
                  "object spends outside the image (leave: %s) or behind the occluder count too; *right*: "
@@ -789,10 +878,10 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard"):
     for name in os.listdir(docs_dir):
         if name.startswith(set_name + "_") and name.endswith(".png"):
             os.remove(os.path.join(docs_dir, name))
-    plot(os.path.join(docs_dir, "%s_overall.png" % set_name), "%s: success vs k" % HARD_SETS[set_name][2],
+    plot(os.path.join(docs_dir, "%s_overall.png" % set_name), "%s: success vs k" % SECTION_TITLES[set_name],
          [(p, [e for r in sel(preset=p) for e in r["normalized_errors"]]) for p in labels], tmp)
     for c in conditions:
-        plot(os.path.join(docs_dir, "%s_%s.png" % (set_name, c)), "%s: %s" % (set_name, HARD_CONDITIONS[c][0]),
+        plot(os.path.join(docs_dir, "%s_%s.png" % (set_name, c)), "%s: %s" % (set_name, condition_titles[c][0]),
              [(p, [e for r in sel(preset=p, condition=c) for e in r["normalized_errors"]]) for p in labels], tmp)
     L.append("### Success curves\n")
     L.append("![%s](benchmarks/%s_overall.png)\n" % (set_name, set_name))
@@ -1188,7 +1277,9 @@ def write_page(repo, docs_dir):
          "`docs/benchmarks/<section>.md` and re-written when that section is run). Sections: "
          "[hard](#hard-section) (hand-held motion, clutter, untextured/open objects, occlusion, "
          "leaving the image, lighting, sensor effects), [hard, second seed set](#hard-section-second-seed-set) "
-         "(the same with other trajectories and backgrounds), [noise](#noise-section) (how much of a "
+         "(the same with other trajectories and backgrounds), [photo](#photo-section-path-traced) (hard "
+         "trajectories path-traced by Blender: shading, shadows, blur and noise the tracker was not tuned on), "
+         "[noise](#noise-section) (how much of a "
          "difference is chance: the hard sets tracked from slightly perturbed initial poses), "
          "[real](#real-section) (ViSP's real sequences: "
          "frames held and contour alignment, not AUC, plus a simulated sequence with ground truth), "
@@ -1215,6 +1306,12 @@ def write_page(repo, docs_dir):
                   % (date, mode), ""]
         block += first_table(fragments["hard"], "### AUC per condition") + [""]
         block += first_table(fragments["hard"], "### AUC per object") + [""]
+    if "photo" in fragments:
+        block += ["**Photo section** (the hard trajectories path-traced by Blender's Cycles: soft shadows, "
+                  "true motion blur, depth of field, sampling noise, clutter in the object's own colours), "
+                  "AUC of 20:", ""]
+        block += first_table(fragments["photo"], "### AUC per condition") + [""]
+        block += first_table(fragments["photo"], "### AUC per object") + [""]
     if "opt" in fragments:
         block += ["**OPT-style section** (the paper's motion groups; easy), AUC of 20:", ""]
         block += first_table(fragments["opt"], "### AUC per object") + [""]
@@ -1294,7 +1391,7 @@ def main():
     summary = []
     for s in sections:
         ts = time.time()
-        run = {"hard": run_hard, "hard2": lambda *a: run_hard(*a, set_name="hard2"), "noise": run_noise,
+        run = {"hard": run_hard, "hard2": lambda *a: run_hard(*a, set_name="hard2"), "photo": run_photo, "noise": run_noise,
                "real": run_real, "opt": run_opt}[s]
         lines, rows = run(args, configs, runner, data, docs_dir, tmp)
         with open(os.path.join(docs_dir, "%s.md" % s), "w") as f:

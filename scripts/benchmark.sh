@@ -2,12 +2,13 @@
 # Benchmark: installs and builds (like demo.sh), generates the missing models and sequences
 # under data/benchmark (cached, deterministic), tracks them with each configuration and writes
 # docs/benchmarks.md (+ docs/benchmarks/<section>.md and the success-curve PNGs).
-#   scripts/benchmark.sh [--section hard|hard2|noise|real|opt ...] [--quick] [--preset NAME ...]
+#   scripts/benchmark.sh [--section hard|hard2|photo|noise|real|opt ...] [--quick] [--preset NAME ...]
 #                        [--variant LABEL:PRESET:param=value,...] [--hard-frames N] [--reuse LABEL]
 #                        [--objects can,chest,...] [--frames N] [--track-frames N]
 #   sections (default: all): hard (hand-held, clutter, occlusion, leaving the image, lighting,
 #     sensor effects; 4 objects x 6 conditions x 80 frames), hard2 (the same with other seeds and
-#     backgrounds: a change is judged on both), noise (realtime, klt_only and each --variant on
+#     backgrounds: a change is judged on both), photo (4 objects x 3 conditions of hard
+#     trajectories path-traced by Blender's Cycles; rendering takes ~1 h the first time), noise (realtime, klt_only and each --variant on
 #     both hard sets from 5 slightly perturbed initial poses: how much of a difference is
 #     chance), real (ViSP's sequences from
 #     visp-images-data), opt (OPT-style groups; --objects/--frames/--track-frames apply to it)
@@ -24,7 +25,7 @@ while [ $# -gt 0 ]; do
     --quick) ARGS+=(--quick); shift ;;
     --preset) [ $# -ge 2 ] || { echo "benchmark: --preset needs a name" >&2; exit 2; }
               ARGS+=(--preset "$2"); shift 2 ;;
-    --section) [ $# -ge 2 ] || { echo "benchmark: --section needs hard, hard2, noise, real or opt" >&2; exit 2; }
+    --section) [ $# -ge 2 ] || { echo "benchmark: --section needs hard, hard2, photo, noise, real or opt" >&2; exit 2; }
                ARGS+=(--section "$2"); shift 2 ;;
     --variant) [ $# -ge 2 ] || { echo "benchmark: --variant needs LABEL:PRESET:param=value,..." >&2; exit 2; }
                ARGS+=(--variant "$2"); shift 2 ;;
@@ -43,18 +44,22 @@ while [ $# -gt 0 ]; do
   esac
 done
 "$KCT_ROOT/scripts/setup.sh"
-# The real section's ViSP sequences and CAD models (Debian's visp-images-data, ~100 MB): needed
-# by the benchmark only, so setup.sh (tests, demo) leaves it out.
-if ! dpkg-query -W -f='${Status}' visp-images-data 2>/dev/null | grep -q "install ok installed"; then
+# Debian packages only the benchmark needs, so setup.sh (tests, demo) leaves them out: the real
+# section's ViSP sequences and CAD models (visp-images-data, ~100 MB) and the photo section's path
+# tracer (blender, ~300 MB with its libraries).
+bench_package() {  # package, what needs it
+  dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed" && return 0
   if [ "$(id -u)" -eq 0 ]; then
-    log "benchmark: installing visp-images-data (the real section's sequences)"
+    log "benchmark: installing $1 ($2)"
     DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends -o DPkg::Lock::Timeout=600 \
-      visp-images-data || { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y \
-      --no-install-recommends visp-images-data; } || log "benchmark: visp-images-data not installed: the real section is skipped"
+      "$1" || { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y \
+      --no-install-recommends "$1"; } || log "benchmark: $1 not installed: $2 is skipped"
   else
-    log "benchmark: visp-images-data is missing (run as root to install it): the real section is skipped"
+    log "benchmark: $1 is missing (run as root to install it): $2 is skipped"
   fi
-fi
+}
+bench_package visp-images-data "the real section"
+bench_package blender "the photo section"
 "$KCT_ROOT/scripts/build.sh"
 source_ws
 export KCT_DATA
