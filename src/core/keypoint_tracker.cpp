@@ -1,6 +1,8 @@
 #include "klt_contour_tracker/core/keypoint_tracker.h"
 
 #include "klt_contour_tracker/core/elapsed.h"
+#include "klt_contour_tracker/core/motion_model.h"
+#include "klt_contour_tracker/core/pose_cost.h"
 #include "klt_contour_tracker/core/pose_cv.h"
 #include "klt_contour_tracker/core/search_area.h"
 #include "klt_contour_tracker/core/surface_anchor.h"
@@ -24,6 +26,45 @@ bool refined_pose_agrees_with_keypoints(const KeypointResult& keypoints, const P
                                          keypoints.object_to_camera, max_increase_px);
   return agreement(refined) <= 0.0;
 }
+
+Pose pose_with_motion_prior(const std::vector<Eigen::Vector3d>& points_object,
+                            const std::vector<Eigen::Vector2d>& points_image,
+                            const PinholeCamera& camera, const Pose& pose, const Pose& expected,
+                            const Eigen::Vector3d& center_object, double sigma_rad, double sigma_m) {
+  const auto residual_sum = [&](const Pose& p) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < points_object.size(); ++i)
+      sum += (camera.project(p * points_object[i]) - points_image[i]).squaredNorm();
+    return sum;
+  };
+  const double dof = std::max(1.0, 2.0 * points_object.size() - 6.0);
+  const double inv_var_px = 1.0 / std::max(1.0, residual_sum(pose) / dof);
+  Vector6d prior_information;
+  prior_information << Eigen::Vector3d::Constant(1.0 / (sigma_rad * sigma_rad)),
+      Eigen::Vector3d::Constant(1.0 / (sigma_m * sigma_m));
+  Pose current = pose;
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    Matrix6d hessian = prior_information.asDiagonal();
+    const Vector6d prior_error = motion_increment_between(expected, current, center_object);
+    Vector6d gradient = prior_information.cwiseProduct(prior_error);
+    const Eigen::Vector3d center_camera = current * center_object;
+    for (std::size_t i = 0; i < points_object.size(); ++i) {
+      const Eigen::Vector3d point_camera = current * points_object[i];
+      if (!(point_camera.z() > 1e-6)) return pose;
+      const Matrix26d jacobian =
+          projection_jacobian(point_camera, center_camera, camera.fx(), camera.fy());
+      const Eigen::Vector2d r = camera.project(point_camera) - points_image[i];
+      hessian += inv_var_px * jacobian.transpose() * jacobian;
+      gradient += inv_var_px * jacobian.transpose() * r;
+    }
+    const Vector6d step = hessian.ldlt().solve(-gradient);
+    if (!step.allFinite()) return pose;
+    current = apply_pose_increment(current, step, center_object);
+    if (step.head<3>().norm() < 1e-6 && step.tail<3>().norm() < 1e-6) break;
+  }
+  return is_valid_pose(current) ? current : pose;
+}
+
 
 KeypointTracker::KeypointTracker(std::shared_ptr<const Mesh> mesh, const TrackerParams& params)
     : mesh_(mesh), renderer_(mesh), params_(params) {}
@@ -288,7 +329,19 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   }
   // Levenberg-Marquardt on all inliers (RANSAC's estimate comes from its best subset).
   cv::solvePnPRefineLM(inlier_object, inlier_image, camera.K(), cv::noArray(), rvec, tvec);
-  const Pose pose = pose_from_rvec_tvec(rvec, tvec);
+  Pose pose = pose_from_rvec_tvec(rvec, tvec);
+  if (params_.keypoint_prior_diameters > 0.0 && diameter_m_ > 0.0 && is_valid_pose(pose)) {
+    std::vector<Eigen::Vector3d> object_points;
+    std::vector<Eigen::Vector2d> image_points;
+    for (std::size_t i = 0; i < inlier_image.size(); ++i) {
+      object_points.emplace_back(inlier_object[i].x, inlier_object[i].y, inlier_object[i].z);
+      image_points.emplace_back(inlier_image[i].x, inlier_image[i].y);
+    }
+    pose = pose_with_motion_prior(object_points, image_points, camera, pose,
+                                  object_to_camera_guess, center_object_,
+                                  params_.keypoint_prior_deg * M_PI / 180.0,
+                                  params_.keypoint_prior_diameters * diameter_m_);
+  }
 
   result.inliers = static_cast<int>(inliers.size());
   result.inlier_ratio = static_cast<double>(result.inliers) / result.tracked;

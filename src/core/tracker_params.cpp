@@ -26,6 +26,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(klt_min_inlier_ratio), KCT_FIELD(redetect_ratio), KCT_FIELD(redetect_interval_frames),
       KCT_FIELD(redetect_max_reprojection_increase_px),
       KCT_FIELD(keypoint_max_motion_diameters), KCT_FIELD(keypoint_max_motion_deg),
+      KCT_FIELD(keypoint_prior_diameters), KCT_FIELD(keypoint_prior_deg),
       KCT_FIELD(keypoint_mask_erosion_px), KCT_FIELD(motion_model),
       KCT_FIELD(motion_velocity_smoothing), KCT_FIELD(motion_error_smoothing),
       KCT_FIELD(klt_predicted_flow), KCT_FIELD(keypoint_motion_gate_sigmas),
@@ -127,6 +128,8 @@ void TrackerParams::validate() const {
               1e6);
   check_range(kOwner, "keypoint_max_motion_diameters", keypoint_max_motion_diameters, 0.0, 1e3);
   check_range(kOwner, "keypoint_max_motion_deg", keypoint_max_motion_deg, 0.0, 180.0);
+  check_range(kOwner, "keypoint_prior_diameters", keypoint_prior_diameters, 0.0, 1e3);
+  check_range(kOwner, "keypoint_prior_deg", keypoint_prior_deg, 1e-3, 180.0);
   check_range(kOwner, "keypoint_mask_erosion_px", keypoint_mask_erosion_px, 0, 100);
   check_range(kOwner, "color_learn_interval_frames", color_learn_interval_frames, 1, 100000);
   check_range(kOwner, "color_lost_ratio", color_lost_ratio, 0.0, 1.0);

@@ -118,7 +118,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 80u);
+  EXPECT_EQ(fields.size(), 82u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -139,6 +139,12 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   EXPECT_THROW(bad.validate(), std::invalid_argument);
   bad = realtime;
   bad.keypoint_max_motion_deg = 200.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.keypoint_prior_diameters = -0.1;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.keypoint_prior_deg = 0.0;
   EXPECT_THROW(bad.validate(), std::invalid_argument);
   bad = realtime;
   bad.color_lost_ratio = 1.5;

@@ -58,6 +58,20 @@ struct KeypointPrediction {
 bool refined_pose_agrees_with_keypoints(const KeypointResult& keypoints, const Pose& refined,
                                         const PinholeCamera& camera, double max_increase_px);
 
+/// Maximum a posteriori pose from 2D-3D correspondences (`points_object` in metres, object
+/// frame; `points_image` in px on the ideal pinhole image of `camera`) and a Gaussian prior on
+/// the frame-to-frame motion away from `expected`: independent per axis of the pose_cost.h
+/// increment about `center_object`, standard deviation `sigma_rad` for the rotation and
+/// `sigma_m` for the centre's translation. Gauss-Newton from `pose` (the PnP pose); the points'
+/// variance is their residual variance at `pose`, at least 1 px^2. Directions the points fix
+/// stay where PnP put them; those they leave free (points in one strip: the depth, a turn about
+/// the strip) stay near the expected pose instead of going wherever the noise sends them.
+/// Returns `pose` when a point is not in front of the camera or the solve fails.
+Pose pose_with_motion_prior(const std::vector<Eigen::Vector3d>& points_object,
+                            const std::vector<Eigen::Vector2d>& points_image,
+                            const PinholeCamera& camera, const Pose& pose, const Pose& expected,
+                            const Eigen::Vector3d& center_object, double sigma_rad, double sigma_m);
+
 /// Owns the anchored keypoints between frames.
 class KeypointTracker {
  public:

@@ -50,6 +50,17 @@ struct TrackerParams {
   /// object, let RANSAC pick a flipped pose 100 mm away; hand-held motion is <= 30 mm / 8 deg).
   double keypoint_max_motion_diameters = 0.0;
   double keypoint_max_motion_deg = 0.0;  ///< ours: see keypoint_max_motion_diameters (0 = off)
+  /// ours (0 = off, the paper): the PnP pose becomes the most likely pose given its inliers and
+  /// a Gaussian prior on the frame-to-frame motion from the expected pose, with this standard
+  /// deviation of the centre's translation (object diameters) and keypoint_prior_deg of the
+  /// rotation. Where the inliers fix the pose it stays; where they leave it free (11 points in
+  /// one strip of a blurred can gave a pose 64 mm too close) it stays near the expected pose
+  /// (pose_with_motion_prior() in keypoint_tracker.h). Off in every preset: realtime with 0.1,
+  /// 2026-11-27: photo section 14.91 -> 15.34 AUC (can 9.46 -> 11.89, toy 17.19 -> 16.36; one
+  /// draw), hard sections' noise draws 11.00 +- 0.34 against 11.39 +- 0.62, paired difference
+  /// -0.39 +- 0.65 (not shown either way).
+  double keypoint_prior_diameters = 0.0;
+  double keypoint_prior_deg = 5.0;  ///< see keypoint_prior_diameters
 
   // ---- Cues for hand-held motion in clutter (ours, beyond the paper; off in `paper`) --------
   /// Erosion of the object's rendered mask before corner detection, px: keypoints stay strictly
@@ -71,7 +82,11 @@ struct TrackerParams {
   /// (motion_prior_cost.h), 0 = off.
   double motion_prior_weight = 0.0;
   /// With the coarse_to_fine optimizer on colour frames: weight of the region (colour) cue
-  /// (region_cue.h, SRT3D-style correspondence lines), 0 = off.
+  /// (region_cue.h, SRT3D-style correspondence lines), 0 = off. Off in every preset: after its
+  /// lines were restricted to the outer outline (2026-11-27), realtime with 0.3 scored 10.40 on
+  /// the hard sections (one draw; realtime 12.35 there, 11.39 +- 0.62 over draws) and 14.53 on
+  /// the photo section (realtime 14.91), with 1: 9.96 and 12.96; it renders the silhouette at
+  /// every re-linearization (chest: median frame ~80 against ~20 ms).
   double region_weight = 0.0;
   int region_line_half_length_px = 12;  ///< pixels sampled on each side of the outline (level 0)
   double region_line_spacing_px = 6.0;  ///< distance between correspondence lines, px
