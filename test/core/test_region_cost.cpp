@@ -10,6 +10,28 @@
 namespace kct {
 namespace {
 
+/// Levenberg-Marquardt on the cue alone from `pose` (damping relative to diag(H), adapted),
+/// 10 steps on level 2, then 1, then 0.
+Pose levenberg_marquardt(RegionCost& cost, Pose pose, const Eigen::Vector3d& center_object) {
+  double lambda = 1.0;
+  for (int level = 2; level >= 0; --level)
+    for (int it = 0; it < 10; ++it) {
+      cost.linearize(pose, level);
+      Vector6d g = Vector6d::Zero();
+      Matrix6d h = Matrix6d::Zero();
+      const double before = cost.evaluate(pose, &g, &h);
+      h.diagonal() += lambda * h.diagonal() + Vector6d::Constant(1e-12);
+      const Pose candidate = apply_pose_increment(pose, -h.ldlt().solve(g), center_object);
+      if (cost.evaluate(candidate, nullptr, nullptr) < before) {
+        pose = candidate;
+        lambda = std::max(1e-3, 0.3 * lambda);
+      } else {
+        lambda *= 10.0;
+      }
+    }
+  return pose;
+}
+
 /// An untextured box over a background of other colours, frames as the refiner builds them.
 class RegionCostTest : public ::testing::Test {
  protected:
@@ -116,23 +138,8 @@ TEST_F(RegionCostTest, CoarseToFineLevenbergMarquardtRecoversAFastMove) {
   cost.begin_frame(frame_);
   Vector6d offset;
   offset << 0.06, -0.05, 0.08, 0.015, -0.01, 0.0;
-  Pose pose = apply_pose_increment(truth_, offset, frame_.center_object);
-  double lambda = 1.0;
-  for (int level = 2; level >= 0; --level)
-    for (int it = 0; it < 10; ++it) {
-      cost.linearize(pose, level);
-      Vector6d g = Vector6d::Zero();
-      Matrix6d h = Matrix6d::Zero();
-      const double before = cost.evaluate(pose, &g, &h);
-      h.diagonal() += lambda * h.diagonal() + Vector6d::Constant(1e-12);
-      const Pose candidate = apply_pose_increment(pose, -h.ldlt().solve(g), frame_.center_object);
-      if (cost.evaluate(candidate, nullptr, nullptr) < before) {
-        pose = candidate;
-        lambda = std::max(1e-3, 0.3 * lambda);
-      } else {
-        lambda *= 10.0;
-      }
-    }
+  const Pose pose = levenberg_marquardt(
+      cost, apply_pose_increment(truth_, offset, frame_.center_object), frame_.center_object);
   const Pose error = truth_.inverse() * pose;
   EXPECT_LT(Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI, 1.0);
   EXPECT_LT((pose.translation() - truth_.translation()).head<2>().norm(), 0.002);
@@ -164,23 +171,7 @@ TEST(RegionCost, StaysAtTheTruePoseOfAnObjectWithInnerOutlines) {
   RegionCost cost(extractor, RegionCueSettings{}, 10, 0.2);
   ASSERT_TRUE(cost.learn(bgr, truth, camera));
   cost.begin_frame(frame);
-  Pose pose = truth;
-  double lambda = 1.0;
-  for (int level = 2; level >= 0; --level)
-    for (int it = 0; it < 10; ++it) {
-      cost.linearize(pose, level);
-      Vector6d g = Vector6d::Zero();
-      Matrix6d h = Matrix6d::Zero();
-      const double before = cost.evaluate(pose, &g, &h);
-      h.diagonal() += lambda * h.diagonal() + Vector6d::Constant(1e-12);
-      const Pose candidate = apply_pose_increment(pose, -h.ldlt().solve(g), frame.center_object);
-      if (cost.evaluate(candidate, nullptr, nullptr) < before) {
-        pose = candidate;
-        lambda = std::max(1e-3, 0.3 * lambda);
-      } else {
-        lambda *= 10.0;
-      }
-    }
+  const Pose pose = levenberg_marquardt(cost, truth, frame.center_object);
   const Pose error = truth.inverse() * pose;
   EXPECT_LT(Eigen::AngleAxisd(error.linear()).angle() * 180 / M_PI, 0.5);
   EXPECT_LT((pose.translation() - truth.translation()).norm(), 0.001);
