@@ -65,7 +65,6 @@ Pose pose_with_motion_prior(const std::vector<Eigen::Vector3d>& points_object,
   return is_valid_pose(current) ? current : pose;
 }
 
-
 KeypointTracker::KeypointTracker(std::shared_ptr<const Mesh> mesh, const TrackerParams& params)
     : mesh_(mesh), renderer_(mesh), params_(params) {}
 
