@@ -329,31 +329,24 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   // Levenberg-Marquardt on all inliers (RANSAC's estimate comes from its best subset).
   cv::solvePnPRefineLM(inlier_object, inlier_image, camera.K(), cv::noArray(), rvec, tvec);
   Pose pose = pose_from_rvec_tvec(rvec, tvec);
-  if (params_.keypoint_prior_diameters > 0.0 && diameter_m_ > 0.0 && is_valid_pose(pose)) {
-    std::vector<Eigen::Vector3d> object_points;
-    std::vector<Eigen::Vector2d> image_points;
-    for (std::size_t i = 0; i < inlier_image.size(); ++i) {
-      object_points.emplace_back(inlier_object[i].x, inlier_object[i].y, inlier_object[i].z);
-      image_points.emplace_back(inlier_image[i].x, inlier_image[i].y);
-    }
-    pose = pose_with_motion_prior(object_points, image_points, camera, pose,
+  std::vector<Eigen::Vector3d>& points_object = result.inlier_points.points_object;
+  std::vector<Eigen::Vector2d>& points_image = result.inlier_points.points_image;
+  for (size_t i = 0; i < inlier_image.size(); ++i) {
+    points_object.emplace_back(inlier_object[i].x, inlier_object[i].y, inlier_object[i].z);
+    points_image.emplace_back(inlier_image[i].x, inlier_image[i].y);
+  }
+  if (params_.keypoint_prior_diameters > 0.0 && diameter_m_ > 0.0 && is_valid_pose(pose))
+    pose = pose_with_motion_prior(points_object, points_image, camera, pose,
                                   object_to_camera_guess, center_object_,
                                   params_.keypoint_prior_deg * M_PI / 180.0,
                                   params_.keypoint_prior_diameters * diameter_m_);
-  }
 
   result.inliers = static_cast<int>(inliers.size());
   result.inlier_ratio = static_cast<double>(result.inliers) / result.tracked;
   double error_sum = 0.0;
-  for (size_t i = 0; i < inlier_image.size(); ++i) {
-    const Eigen::Vector3d p(inlier_object[i].x, inlier_object[i].y, inlier_object[i].z);
-    const Eigen::Vector2d uv = camera.project(pose * p);
-    const Eigen::Vector2d observed(inlier_image[i].x, inlier_image[i].y);
-    error_sum += (uv - observed).norm();
-    result.inlier_points.points_object.push_back(p);
-    result.inlier_points.points_image.push_back(observed);
-  }
-  result.mean_reprojection_px = error_sum / inlier_image.size();
+  for (size_t i = 0; i < points_object.size(); ++i)
+    error_sum += (camera.project(pose * points_object[i]) - points_image[i]).norm();
+  result.mean_reprojection_px = error_sum / points_object.size();
 
   const bool pose_ok = is_valid_pose(pose) && pose.translation().z() > 0;
   result.implausible_motion = pose_ok && implausible_motion(object_to_camera_guess, pose);

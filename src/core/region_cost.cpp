@@ -47,10 +47,7 @@ void RegionCost::linearize(const Pose& object_to_camera, int level) {
     if (moved_px < 0.25 * scale) return;
   }
   // The silhouette at this pose keeps the lines on the outer outline (RegionCue::linearize).
-  RenderOptions options;
-  options.draw_color = false;
-  cue_.linearize(object_to_camera, camera, scale,
-                 renderer_.render(object_to_camera, camera, options).mask());
+  cue_.linearize(object_to_camera, camera, scale, silhouette(object_to_camera, camera));
   lines_level_ = level;
   lines_pose_ = object_to_camera;
 }
@@ -64,9 +61,13 @@ double RegionCost::evaluate(const Pose& object_to_camera, Vector6d* gradient,
 bool RegionCost::learn(const cv::Mat& bgr, const Pose& object_to_camera,
                        const PinholeCamera& camera) {
   if (bgr.empty() || bgr.type() != CV_8UC3 || bgr.size() != camera.size()) return false;
+  return learn(bgr, silhouette(object_to_camera, camera));
+}
+
+cv::Mat RegionCost::silhouette(const Pose& object_to_camera, const PinholeCamera& camera) const {
   RenderOptions options;
   options.draw_color = false;
-  return learn(bgr, renderer_.render(object_to_camera, camera, options).mask());
+  return renderer_.render(object_to_camera, camera, options).mask();
 }
 
 bool RegionCost::learn(const cv::Mat& bgr, const cv::Mat& mask) {

@@ -14,6 +14,13 @@ constexpr double kMinDepth = 1e-6;  // metres
 // rasterization's half-pixel uncertainty of where the edge falls.
 constexpr double kProbePx = 1.5;
 
+/// The silhouette's pixel nearest to `p`, or null outside the image.
+const uchar* silhouette_pixel(const cv::Mat& silhouette, const Eigen::Vector2d& p) {
+  const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+  if (x < 0 || y < 0 || x >= silhouette.cols || y >= silhouette.rows) return nullptr;
+  return &silhouette.at<uchar>(y, x);
+}
+
 /// The vertex of `face` that is neither end of the edge (v0, v1); -1 if none.
 int opposite_vertex(const Mesh& mesh, int face, int v0, int v1) {
   for (int k = 0; k < 3; ++k) {
@@ -84,11 +91,6 @@ void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& cam
       (silhouette.type() != CV_8UC1 || silhouette.cols != camera.width() ||
        silhouette.rows != camera.height()))
     throw std::invalid_argument("RegionCue::linearize: silhouette must be CV_8UC1 of the camera's size");
-  const auto on_object = [&silhouette](const Eigen::Vector2d& p) {
-    const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
-    return x >= 0 && y >= 0 && x < silhouette.cols && y < silhouette.rows &&
-           silhouette.at<uchar>(y, x) != 0;
-  };
   camera_ = camera;
   scale_ = scale;
   lines_.clear();
@@ -136,7 +138,10 @@ void RegionCue::linearize(const Pose& object_to_camera, const PinholeCamera& cam
       if (point_camera.z() <= kMinDepth) continue;
       line.centre_px = camera.project(point_camera);
       line.normal = normal;
-      if (!silhouette.empty() && on_object(line.centre_px + kProbePx * normal)) continue;
+      if (!silhouette.empty()) {
+        const uchar* outside = silhouette_pixel(silhouette, line.centre_px + kProbePx * normal);
+        if (outside && *outside != 0) continue;  // the object again: not the outer outline
+      }
       place_line(line, scale, silhouette);
       lines_.push_back(line);
     }
@@ -154,9 +159,8 @@ void RegionCue::place_line(Line& line, double scale, const cv::Mat& silhouette) 
       const Eigen::Vector2d p = line.centre_px + (j + 0.5) * scale * line.normal;
       // Within kProbePx of the centre the rasterized silhouette's edge is uncertain.
       if (!silhouette.empty() && std::abs(j + 0.5) * scale > kProbePx) {
-        const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
-        const bool inside_image = x >= 0 && y >= 0 && x < silhouette.cols && y < silhouette.rows;
-        if (inside_image && (silhouette.at<uchar>(y, x) != 0) != (direction < 0)) break;
+        const uchar* pixel = silhouette_pixel(silhouette, p);
+        if (pixel && (*pixel != 0) != (direction < 0)) break;
       }
       contrast_[j + half] = 2.0 * posterior_at(p.x(), p.y()) - 1.0;
       informative = informative || contrast_[j + half] != 0.0;

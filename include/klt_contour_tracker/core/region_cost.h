@@ -44,6 +44,9 @@ class RegionCost : public PoseCost {
   const ColorHistograms& histograms() const { return histograms_; }
 
  private:
+  /// The mesh's mask (CV_8UC1, non-zero on the object) rendered at a pose.
+  cv::Mat silhouette(const Pose& object_to_camera, const PinholeCamera& camera) const;
+
   RegionCue cue_;
   ColorHistograms histograms_;
   Renderer renderer_;
