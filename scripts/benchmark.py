@@ -499,17 +499,28 @@ HARD_SETS = {
 SECTION_TITLES = dict({k: v[2] for k, v in HARD_SETS.items()}, photo="Photo section (path-traced)")
 
 
-def hard_sequence(data, obj, cond, frames, set_name="hard"):
+def sequence_seed(tag, obj, cond):
+    """The seed of a generated sequence, from its set's tag, object and condition."""
+    return zlib.crc32(("%s/%s/%s" % (tag, obj, cond)).encode()) % 100000 + 1
+
+
+def generated_sequence(data, obj, folder, frames, seed, background, options, extra, what):
+    """generate_sequence of a hard object into folder, cached: `options`, then the object's
+    render options, then `extra`."""
     spec = HARD_OBJECTS[obj]
-    tag, background_index, _ = HARD_SETS[set_name]
-    seed = zlib.crc32(("%s/%s/%s" % (tag, obj, cond)).encode()) % 100000 + 1
-    backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
-    folder = os.path.join(data, set_name, obj, cond)
     cmd = ["rosrun", "klt_contour_tracker", "generate_sequence", "--model", ensure_model(data, spec["model"]),
            "--output-dir", folder, "--frames", frames, "--seed", seed,
-           "--background", os.path.join(PHOTOS, backgrounds[background_index(seed) % len(backgrounds)])]
-    cmd += HARD_BASE + spec["render"] + HARD_CONDITIONS[cond][1]
-    return cached_run(cmd, folder, "rendering %s/%s/%s" % (set_name, obj, cond))
+           "--background", os.path.join(PHOTOS, background)] + list(options) + spec["render"] + list(extra)
+    return cached_run(cmd, folder, what)
+
+
+def hard_sequence(data, obj, cond, frames, set_name="hard"):
+    tag, background_index, _ = HARD_SETS[set_name]
+    seed = sequence_seed(tag, obj, cond)
+    backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
+    return generated_sequence(data, obj, os.path.join(data, set_name, obj, cond), frames, seed,
+                              backgrounds[background_index(seed) % len(backgrounds)], HARD_BASE,
+                              HARD_CONDITIONS[cond][1], "rendering %s/%s/%s" % (set_name, obj, cond))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -539,21 +550,18 @@ def photo_source(data, obj, cond):
         return hard_sequence(data, obj, source_cond, HARD_FRAMES, set_name)
     # A trajectory the hard section has not: slow and smooth (generate_sequence's own frames are
     # only a by-product here).
-    spec = HARD_OBJECTS[obj]
-    seed = zlib.crc32(("photo/%s/%s" % (obj, cond)).encode()) % 100000 + 1
-    folder = os.path.join(data, "photo_source", obj, cond)
+    seed = sequence_seed("photo", obj, cond)
     base = list(HARD_BASE)
     for flag, value in zip(("--typical-translation-mm", "--typical-rotation-deg", "--jerk-probability"), slow):
         base[base.index(flag) + 1] = value
-    cmd = ["rosrun", "klt_contour_tracker", "generate_sequence", "--model", ensure_model(data, spec["model"]),
-           "--output-dir", folder, "--frames", HARD_FRAMES, "--seed", seed,
-           "--background", os.path.join(PHOTOS, BACKGROUNDS[seed % len(BACKGROUNDS)])] + base + spec["render"]
-    return cached_run(cmd, folder, "trajectory photo_source/%s/%s" % (obj, cond))
+    return generated_sequence(data, obj, os.path.join(data, "photo_source", obj, cond), HARD_FRAMES, seed,
+                              BACKGROUNDS[seed % len(BACKGROUNDS)], base, [],
+                              "trajectory photo_source/%s/%s" % (obj, cond))
 
 
 def photo_sequence(data, obj, cond, repo):
     source = photo_source(data, obj, cond)
-    seed = zlib.crc32(("photo/%s/%s" % (obj, cond)).encode()) % 100000 + 1
+    seed = sequence_seed("photo", obj, cond)
     folder = os.path.join(data, "photo", obj, cond)
     clutter = HARD_BACKGROUNDS["clutter"]
     cmd = ["blender", "-b", "--factory-startup", "-noaudio", "-P", os.path.join(repo, "scripts", "photoreal_render.py"),
@@ -1034,7 +1042,7 @@ def seq_name(group, speed):
 def opt_sequence(data, obj, group, speed):
     spec = OBJECTS[obj]
     folder = os.path.join(data, "sequences", obj, seq_name(group, speed))
-    seed = zlib.crc32(("%s/%s/%d" % (obj, group, speed)).encode()) % 100000 + 1
+    seed = sequence_seed(obj, group, speed)
     background = os.path.join(PHOTOS, BACKGROUNDS[seed % len(BACKGROUNDS)])
     cmd = ["rosrun", "klt_contour_tracker", "generate_sequence",
            "--model", ensure_model(data, spec["model"]), "--output-dir", folder,

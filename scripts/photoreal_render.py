@@ -213,7 +213,8 @@ def main():
             bpy.ops.mesh.primitive_uv_sphere_add(radius=size * 0.8, location=(x, y, z))
         thing = bpy.context.active_object
         thing.rotation_euler = (rng.uniform(0, math.pi), rng.uniform(0, math.pi), rng.uniform(0, math.pi))
-        bpy.ops.object.shade_smooth() if kind != "cube" else None
+        if kind != "cube":
+            bpy.ops.object.shade_smooth()
         bpy.ops.object.editmode_toggle()
         bpy.ops.uv.smart_project()
         bpy.ops.object.editmode_toggle()
