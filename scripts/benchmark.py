@@ -69,6 +69,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_region", "realtime", {"region_weight": "1"}),
     # the PnP pose made the most likely pose under a prior on the frame-to-frame motion
     ("realtime_keypoint_prior", "realtime", {"keypoint_prior_diameters": "0.1"}),
+    # re-acquisition keeps to 0.25 diameters a frame around the last good pose (not a far twin)
+    ("realtime_search_reach", "realtime", {"color_search_reach_diameters": "0.25"}),
     # ORB keyframes: tracking by detection for textured objects (feature_relocalizer.h)
     ("realtime_feature_relocalization", "realtime", {"feature_relocalization": "true"}),
     ("realtime_motion_model", "realtime",

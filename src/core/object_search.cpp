@@ -201,13 +201,18 @@ std::vector<SearchCandidate> ObjectSearch::score(const cv::Mat& bgr,
 }
 
 std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose& reference,
-                                                  const PinholeCamera& camera) const {
+                                                  const PinholeCamera& camera,
+                                                  double reach_px) const {
   std::vector<SearchCandidate> candidates;
   const double reference_depth = (reference * center_object_).z();
   if (!ready() || !(reference_depth > 0)) return candidates;
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
   const cv::Mat posterior = posterior_map(small);
+  // The reach around the reference's centre, in working-image px (squared; 0: anywhere).
+  const Eigen::Vector2d reference_px = working_camera.project(reference * center_object_);
+  const double reach_working = reach_px * working_camera.fx() / camera.fx();
+  const double reach2 = reach_px > 0.0 ? reach_working * reach_working : 0.0;
   RenderOptions options;
   options.draw_color = false;
   for (double scale : settings_.depth_scales) {
@@ -258,6 +263,7 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
         const float area_inside = in_image(inside_integral, r, c);
         const float area_ring = in_image(ring_integral, r, c);
         if (area_inside < min_area || area_ring < 1.0f) continue;
+        if (reach2 > 0.0 && (Eigen::Vector2d(c, r) - reference_px).squaredNorm() > reach2) continue;
         const double contrast = pi[c] / area_inside - pr[c] / area_ring;
         if (contrast > best) {
           best = contrast;

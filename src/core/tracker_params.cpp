@@ -38,6 +38,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(color_keypoint_veto_inliers), KCT_FIELD(color_vanished_ratio),
       KCT_FIELD(color_accept_ratio),
       KCT_FIELD(color_search_placements), KCT_FIELD(color_search_rotation_deg),
+      KCT_FIELD(color_search_reach_diameters),
       KCT_FIELD(color_confirm_ratio), KCT_FIELD(drop_unconfirmed_anchors),
       KCT_FIELD(feature_relocalization), KCT_FIELD(relocalization_override_inliers),
       KCT_FIELD(rotation_check_deg), KCT_FIELD(rotation_check_frames),
@@ -139,6 +140,7 @@ void TrackerParams::validate() const {
   check_range(kOwner, "color_accept_ratio", color_accept_ratio, 0.0, 1.0);
   check_range(kOwner, "color_search_placements", color_search_placements, 1, 5);
   check_range(kOwner, "color_search_rotation_deg", color_search_rotation_deg, 0.0, 90.0);
+  check_range(kOwner, "color_search_reach_diameters", color_search_reach_diameters, 0.0, 100.0);
   check_range(kOwner, "color_confirm_ratio", color_confirm_ratio, 0.0, 1.0);
   check_range(kOwner, "motion_velocity_smoothing", motion_velocity_smoothing, 1e-6, 1.0);
   check_range(kOwner, "motion_error_smoothing", motion_error_smoothing, 1e-6, 1.0);

@@ -101,6 +101,7 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   unconfirmed_.reset();
   rotation_check_winner_ = -1;
   frames_since_doubt_ = 1000;
+  frames_since_good_ = 0;
 }
 
 void TrackingSession::reset() {
@@ -144,7 +145,8 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     // was hidden), plus the last good pose and the last frame's; each refined, the best colour
     // contrast wins.
     const PinholeCamera& camera = tracker_->camera();
-    std::vector<SearchCandidate> found = search_->search(bgr, last_good, camera);
+    const double reach_px = search_reach_px();
+    std::vector<SearchCandidate> found = search_->search(bgr, last_good, camera, reach_px);
     if (static_cast<int>(found.size()) > params_.color_search_placements)
       found.resize(static_cast<std::size_t>(params_.color_search_placements));
     std::vector<Pose> hypotheses{last_good};
@@ -167,9 +169,18 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     std::vector<Pose> refined_poses;
     for (const TrackResult& r : refined) refined_poses.push_back(r.object_to_camera);
     const std::vector<SearchCandidate> scored = search_->score(bgr, refined_poses, camera);
+    // A hypothesis the refinement took out of reach is not a candidate (the last good pose,
+    // the first, is the fallback).
+    const Eigen::Vector2d last_good_px = camera.project(last_good * center_object);
+    const auto in_reach = [&](const Pose& pose) {
+      const Eigen::Vector3d c = pose * center_object;
+      return reach_px <= 0.0 ||
+             (c.z() > 0.0 && (camera.project(c) - last_good_px).norm() <= reach_px);
+    };
     std::size_t best_index = 0;
     for (std::size_t i = 1; i < scored.size(); ++i)
-      if (scored[i].contrast > scored[best_index].contrast) best_index = i;
+      if (scored[i].contrast > scored[best_index].contrast && in_reach(refined_poses[i]))
+        best_index = i;
     TrackResult best = refined[best_index];
     const double best_contrast = scored[best_index].contrast;
     // color_confirm_ratio: a weaker best hypothesis counts when the previous frame's best was at
@@ -195,6 +206,15 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   }
   if (color_only) return TrackResult();
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
+}
+
+double TrackingSession::search_reach_px() const {
+  if (!(params_.color_search_reach_diameters > 0.0)) return 0.0;
+  const Pose& last_good = monitor_.last_good_pose();
+  const double depth_m = (last_good * tracker_->center_object()).z();
+  if (!(depth_m > 0.0)) return 0.0;
+  return params_.color_search_reach_diameters * (frames_since_good_ + 1) * tracker_->diameter_m() *
+         tracker_->camera().fx() / depth_m;
 }
 
 bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
@@ -475,6 +495,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   const bool doubt = result.frame.status == TrackStatus::kExtrapolated ||
                      result.frame.status == TrackStatus::kReacquired;
   frames_since_doubt_ = doubt ? 0 : frames_since_doubt_ + 1;
+  frames_since_good_ = result.has_pose() && monitor_.last_good() ? 0 : frames_since_good_ + 1;
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();

@@ -142,6 +142,38 @@ TEST_F(ObjectSearchTest, FindsAnObjectEnteringTheImage) {
   EXPECT_LT(found.front().visible_fraction, 0.9);
 }
 
+TEST_F(ObjectSearchTest, AReachKeepsTheSearchNearTheReference) {
+  ObjectSearch search(mesh_);
+  const Pose learned_at = test::make_pose(0.4);
+  ASSERT_TRUE(search.learn(frame_at(learned_at), learned_at, camera_));
+  // Two copies of the object: one 2 cm beside the reference with a background-coloured bar
+  // across its middle (a weaker match), a twin 15 cm away, whole (the better match).
+  const Pose near = test::move(learned_at, 0, Eigen::Vector3d::UnitZ(), {0.02, 0.0, 0.0});
+  const Pose twin = test::move(learned_at, 0, Eigen::Vector3d::UnitZ(), {-0.15, 0.0, 0.0});
+  cv::Mat frame = frame_at(twin);
+  const cv::Mat near_frame = frame_at(near);
+  cv::Mat near_mask = renderer_->render(near, camera_).mask();
+  near_frame.copyTo(frame, near_mask);
+  const Eigen::Vector3d c = mesh_->bounding_box_center();
+  const Eigen::Vector2d near_px = camera_.project(near * c), twin_px = camera_.project(twin * c);
+  cv::rectangle(frame, cv::Point2d(near_px.x() - 80, near_px.y() - 8),
+                cv::Point2d(near_px.x() + 80, near_px.y() + 8), cv::Scalar(200, 120, 40), cv::FILLED);
+  const auto found_px = [&](double reach_px) {
+    const std::vector<SearchCandidate> found = search.search(frame, learned_at, camera_, reach_px);
+    EXPECT_FALSE(found.empty());
+    return found.empty() ? Eigen::Vector2d(-1e9, -1e9)
+                         : Eigen::Vector2d(camera_.project(found.front().object_to_camera * c));
+  };
+  // The whole frame: the twin wins; within 60 px of the reference's centre: the near copy
+  // (its placement may slide along the bar: 25 px, where the twin is 250 px away).
+  EXPECT_LT((found_px(0.0) - twin_px).norm(), 8.0);
+  const Eigen::Vector2d reference_px = camera_.project(learned_at * c);
+  ASSERT_GT((twin_px - reference_px).norm(), 150.0);  // the twin is out of reach
+  EXPECT_LT((found_px(60.0) - near_px).norm(), 25.0);
+  for (const SearchCandidate& candidate : search.search(frame, learned_at, camera_, 60.0))
+    EXPECT_LE((camera_.project(candidate.object_to_camera * c) - reference_px).norm(), 60.0 + 2.0);
+}
+
 TEST_F(ObjectSearchTest, GreyFramesStoredAsColourAreRecognized) {
   const cv::Mat colour = frame_at(test::make_pose(0.4));
   EXPECT_FALSE(ObjectSearch::looks_grey(colour));

@@ -118,7 +118,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 82u);
+  EXPECT_EQ(fields.size(), 83u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

@@ -67,12 +67,13 @@ class ObjectSearch {
   std::vector<SearchCandidate> score(const cv::Mat& bgr, const std::vector<Pose>& object_to_camera,
                                      const PinholeCamera& camera) const;
 
-  /// Searches the whole frame: the rotation of `reference` (object_to_camera) at the depths
+  /// Searches the frame: the rotation of `reference` (object_to_camera) at the depths
   /// depth_scales x its depth, placed anywhere its silhouette is at least min_visible_fraction
-  /// in the image. One candidate per depth (its best placement), best contrast first; empty when
-  /// the model is not ready.
+  /// in the image and, with `reach_px` > 0, its centre at most `reach_px` (full-resolution px)
+  /// from the reference's projected centre (0: anywhere). One candidate per depth (its best
+  /// placement), best contrast first; empty when the model is not ready.
   std::vector<SearchCandidate> search(const cv::Mat& bgr, const Pose& reference,
-                                      const PinholeCamera& camera) const;
+                                      const PinholeCamera& camera, double reach_px = 0.0) const;
 
   const ObjectSearchSettings& settings() const { return settings_; }
 

@@ -122,6 +122,9 @@ class TrackingSession {
   /// (searched false).
   TrackResult reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched,
                         bool color_only = false);
+  /// color_search_reach_diameters: how far (full-resolution px) from the last good pose's
+  /// projected centre the object can be on this frame; 0 = anywhere.
+  double search_reach_px() const;
   void count(const SessionResult& result);
   /// feature_relocalization, on a frame the pipeline tracked (`gray` undistorted): the
   /// keyframes' features around the held pose confirm it, or replace it when they disagree.
@@ -167,6 +170,7 @@ class TrackingSession {
   std::unique_ptr<SurfaceTexture> texture_;
   int texture_check_winner_ = -1;  ///< the turn that won texture_check on the last frame
   int frames_since_doubt_ = 1000;  ///< frames since KLT last failed or a re-acquisition
+  int frames_since_good_ = 0;      ///< frames since the last good one (0: the last was good)
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
   bool has_last_stamp_ = false;
