@@ -63,14 +63,15 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_texture_check_in_window", "realtime", {"texture_check_every_frame": "false"}),
     # a KLT failure whose refined pose lost the colours waits for the declared loss to be searched
     ("realtime_no_extrapolated_search", "realtime", {"extrapolated_search_ratio": "0"}),
+    # re-acquisition searches the whole frame (not only as far as the object could have moved)
+    ("realtime_no_search_reach", "realtime", {"color_search_reach_diameters": "0"}),
     # keypoints anchored after a KLT failure kept even when the frame is judged bad
     ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     # the PnP pose made the most likely pose under a prior on the frame-to-frame motion
     ("realtime_keypoint_prior", "realtime", {"keypoint_prior_diameters": "0.1"}),
-    # re-acquisition keeps to 0.25 diameters a frame around the last good pose (not a far twin)
-    ("realtime_search_reach", "realtime", {"color_search_reach_diameters": "0.25"}),
+
     # ORB keyframes: tracking by detection for textured objects (feature_relocalizer.h)
     ("realtime_feature_relocalization", "realtime", {"feature_relocalization": "true"}),
     ("realtime_motion_model", "realtime",

@@ -268,6 +268,57 @@ TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
   }
 }
 
+/// color_search_reach_diameters: the red box is hidden until the session declares it lost, then
+/// comes back 2 cm from where it was, its middle covered by a bar, while a whole twin stands 17 cm
+/// away on the other side (the better colour match). Searching the whole frame takes the twin;
+/// with a reach (here 0.05 diameters a frame, so that the twin is out of it after the frames
+/// hidden) the box is taken.
+TEST(TrackingSession, AReachKeepsReacquisitionOffAFarTwin) {
+  const ColourScene scene;
+  const Pose near = test::move(scene.start, 0.0, {0.0, 0.0, 1.0}, {-0.02, 0.0, 0.0});
+  const Pose twin = test::move(scene.start, 0.0, {0.0, 0.0, 1.0}, {0.17, 0.0, 0.0});
+  const Eigen::Vector3d centre = scene.mesh->bounding_box_center();
+  const auto shown = [&](int noise_seed) {
+    cv::Mat frame = test::render_frame(scene.renderer, scene.camera, twin, scene.background, 1.5, noise_seed);
+    const cv::Mat near_frame =
+        test::render_frame(scene.renderer, scene.camera, near, scene.background, 1.5, noise_seed);
+    near_frame.copyTo(frame, scene.renderer.render(near, scene.camera).mask());
+    const Eigen::Vector2d c = scene.camera.project(near * centre);
+    cv::rectangle(frame, cv::Point2d(c.x() - 90, c.y() - 30), cv::Point2d(c.x() + 90, c.y() + 30),
+                  cv::Scalar(90, 70, 40), cv::FILLED);
+    return frame;
+  };
+  TrackerParams params = quick_realtime();
+  for (const double reach : {0.0, 0.05}) {
+    params.color_search_reach_diameters = reach;
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.initialize(scene.start);
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033)
+      ASSERT_EQ(session.track({test::render_frame(scene.renderer, scene.camera, scene.start,
+                                                  scene.background, 1.5, i),
+                               stamp}).state,
+                TrackState::kTracking) << i;
+    for (int i = 0; i < 15 && session.state() != TrackState::kLost; ++i, stamp += 0.033)
+      session.track({scene.background.clone(), stamp});
+    ASSERT_EQ(session.state(), TrackState::kLost) << "the hidden box must be declared lost";
+    Pose taken = scene.start;
+    bool reacquired = false;
+    for (int i = 0; i < 10 && !reacquired; ++i, stamp += 0.033) {
+      const SessionResult r = session.track({shown(50 + i), stamp});
+      reacquired = r.state == TrackState::kTracking;
+      taken = r.frame.object_to_camera;
+    }
+    ASSERT_TRUE(reacquired) << "reach " << reach;
+    // Tolerance: 2 cm (the bar hides part of the near box's outline); the two are 19 cm apart.
+    if (reach > 0.0)
+      EXPECT_LT(translation_error(taken, near), 0.02);
+    else
+      EXPECT_LT(translation_error(taken, twin), 0.02) << "the twin must win without a reach: no test";
+  }
+}
+
 /// extrapolated_search_ratio: the red box jumps 18 cm sideways between two frames (too far for
 /// KLT and for the shift search). The refined pose of the jump frame has lost the colours; with
 /// the ratio the colour search runs on that frame and finds the box there, without it the track
@@ -277,6 +328,9 @@ TEST(TrackingSession, AJumpIsSearchedForOnTheFrameItHappens) {
   const Pose away = test::move(scene.start, 8.0, {0.2, 1.0, 0.3}, {-0.15, 0.1, 0.0});
   TrackerParams params = quick_realtime();
   ASSERT_GT(params.extrapolated_search_ratio, 0.0) << "realtime searches at once";
+  // The jump (1.2 diameters in a frame) is beyond what a hand moves an object in a frame, which
+  // the reach assumes: searched over the whole frame here.
+  params.color_search_reach_diameters = 0.0;
   for (const double ratio : {0.0, params.extrapolated_search_ratio}) {
     params.extrapolated_search_ratio = ratio;
     TrackingSession session(scene.mesh, params);
