@@ -71,7 +71,6 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_region", "realtime", {"region_weight": "1"}),
     # the PnP pose made the most likely pose under a prior on the frame-to-frame motion
     ("realtime_keypoint_prior", "realtime", {"keypoint_prior_diameters": "0.1"}),
-
     # ORB keyframes: tracking by detection for textured objects (feature_relocalizer.h)
     ("realtime_feature_relocalization", "realtime", {"feature_relocalization": "true"}),
     ("realtime_motion_model", "realtime",

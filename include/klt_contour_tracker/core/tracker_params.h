@@ -116,12 +116,12 @@ struct TrackerParams {
   /// good pose, and continues from the refined pose with the best colour contrast.
   int color_search_placements = 2;
   double color_search_rotation_deg = 20.0;
-  /// ours (0 = off: the whole frame; realtime 0.25): the colour search and its hypotheses keep to a disc
-  /// around the last good pose's projected centre whose radius grows by this many object
-  /// diameters (at the last good depth) per frame since that pose. A hand-held object moves at
-  /// most ~0.25 diameters a frame; a thing of the object's colours (or texture) farther away than
-  /// it could have gone is then not taken for it, while an object that left the image for a
-  /// while is still searched for everywhere.
+  /// ours (0 = off: the whole frame; realtime 0.25): the colour search and its hypotheses keep
+  /// to a disc around the last good pose's projected centre whose radius grows by this many
+  /// object diameters (at the last good depth) per frame since that pose. A hand-held object
+  /// moves at most ~0.25 diameters a frame; a thing of the object's colours (or texture) farther
+  /// away than it could have gone is then not taken for it, while an object that left the image
+  /// for a while is still searched for everywhere.
   double color_search_reach_diameters = 0.0;
   /// ours (0 = off): a re-acquisition hypothesis below color_accept_ratio but with at least this
   /// share of the contrast level is accepted when the previous frame's best hypothesis was
