@@ -101,7 +101,6 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   unconfirmed_.reset();
   rotation_check_winner_ = -1;
   frames_since_doubt_ = 1000;
-  frames_since_good_ = 0;
 }
 
 void TrackingSession::reset() {
@@ -213,8 +212,9 @@ double TrackingSession::search_reach_px() const {
   const Pose& last_good = monitor_.last_good_pose();
   const double depth_m = (last_good * tracker_->center_object()).z();
   if (!(depth_m > 0.0)) return 0.0;
-  return params_.color_search_reach_diameters * (frames_since_good_ + 1) * tracker_->diameter_m() *
-         tracker_->camera().fx() / depth_m;
+  // This frame is consecutive_bad_frames() + 1 frames after the last good one.
+  return params_.color_search_reach_diameters * (monitor_.consecutive_bad_frames() + 1) *
+         tracker_->diameter_m() * tracker_->camera().fx() / depth_m;
 }
 
 bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
@@ -495,7 +495,6 @@ SessionResult TrackingSession::track(const Frame& frame) {
   const bool doubt = result.frame.status == TrackStatus::kExtrapolated ||
                      result.frame.status == TrackStatus::kReacquired;
   frames_since_doubt_ = doubt ? 0 : frames_since_doubt_ + 1;
-  frames_since_good_ = result.has_pose() && monitor_.last_good() ? 0 : frames_since_good_ + 1;
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();

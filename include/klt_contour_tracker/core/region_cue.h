@@ -44,8 +44,9 @@ struct RegionCueSettings {
 ///   p_i(d) ~ prod_j [h_f(s_j - d) P_ij + (1 - h_f(s_j - d)) (1 - P_ij)]
 /// over d = k scale, |k| < L (SRT3D Eq. 7-9); with a silhouette, only lines on the outer
 /// outline, each cut where it meets another part of the object or leaves a thin one (see
-/// linearize()). Its mean mu_i and variance sigma_i^2 (at least (scale / 2)^2) are held fixed until the next linearize(). evaluate() projects X_i at the
-/// pose, takes its shift delta_i = n_i . (pi(X_i) - c_i) along the line and returns
+/// linearize()). Its mean mu_i and variance sigma_i^2 (at least (scale / 2)^2) are held fixed
+/// until the next linearize(). evaluate() projects X_i at the pose, takes its shift
+/// delta_i = n_i . (pi(X_i) - c_i) along the line and returns
 ///   cost = (1 / N) sum_i 0.5 w_i (delta_i - mu_i)^2,  w_i = 1 / sigma_i^2 - 1 / sigma_u^2,
 /// sigma_u^2 the variance of a uniform p_i (w_i >= 0: a line that tells nothing, all its
 /// P = 1/2 or outside the image, weighs exactly 0; N counts every line, so poses pushing the

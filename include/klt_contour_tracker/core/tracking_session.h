@@ -170,7 +170,6 @@ class TrackingSession {
   std::unique_ptr<SurfaceTexture> texture_;
   int texture_check_winner_ = -1;  ///< the turn that won texture_check on the last frame
   int frames_since_doubt_ = 1000;  ///< frames since KLT last failed or a re-acquisition
-  int frames_since_good_ = 0;      ///< frames since the last good one (0: the last was good)
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
   bool has_last_stamp_ = false;
