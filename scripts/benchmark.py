@@ -61,6 +61,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_texture_check", "realtime", {"texture_check_margin": "0"}),
     # ... checked only in rotation_check's window, also for objects with a colour pattern
     ("realtime_texture_check_in_window", "realtime", {"texture_check_every_frame": "false"}),
+    # a held pose whose surface colours disagree is not searched for by shifts
+    ("realtime_no_texture_shift", "realtime", {"texture_shift_search_below": "0"}),
     # a KLT failure whose refined pose lost the colours waits for the declared loss to be searched
     ("realtime_no_extrapolated_search", "realtime", {"extrapolated_search_ratio": "0"}),
     # re-acquisition searches the whole frame (not only as far as the object could have moved)

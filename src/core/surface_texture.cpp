@@ -148,6 +148,30 @@ void SurfaceTexture::learn(const cv::Mat& bgr, const Pose& object_to_camera,
   color_pattern_ = textured_ && std::sqrt(chroma_variance / chroma.size()) >= kMinChromaStd;
 }
 
+TextureShift SurfaceTexture::best_shift(const PreparedFrame& prepared, const Pose& object_to_camera,
+                                        const PinholeCamera& camera, double lateral_step_m, int steps,
+                                        double depth_step_ratio) const {
+  TextureShift best;
+  best.agreement.correlation = -1.0;
+  const double depth_m = (object_to_camera * center_object_).z();
+  for (int iz = -1; iz <= 1; ++iz)
+    for (int ix = -steps; ix <= steps; ++ix)
+      for (int iy = -steps; iy <= steps; ++iy) {
+        if (ix == 0 && iy == 0 && iz == 0) continue;
+        const Eigen::Vector3d shift(ix * lateral_step_m, iy * lateral_step_m, iz * depth_step_ratio * depth_m);
+        Pose shifted = object_to_camera;
+        shifted.translation() += shift;
+        const TextureAgreement a = agreement(prepared, shifted, camera);
+        // Ties keep the first: the scan order makes the result deterministic.
+        if (a.points >= kMinPoints && a.correlation > best.agreement.correlation) {
+          best.object_to_camera = shifted;
+          best.shift_camera_m = shift;
+          best.agreement = a;
+        }
+      }
+  return best;
+}
+
 TextureAgreement SurfaceTexture::agreement(const PreparedFrame& prepared, const Pose& object_to_camera,
                                            const PinholeCamera& camera) const {
   TextureAgreement result;

@@ -26,6 +26,13 @@ constexpr double kRotationCheckMaxShiftDiameters = 0.2;
 /// texture_check: a turn must correlate at least this well with the learned surface colours
 /// (weaker matches are as often a wrong turn as a right one).
 constexpr double kTextureCheckMinCorrelation = 0.5;
+/// texture_shift_search_below: the grid of shifts (lateral step and count each way, in
+/// diameters; depth step, share of the depth) and how far two frames' shifts may differ to
+/// confirm each other (diameters).
+constexpr double kShiftStepDiameters = 0.05;
+constexpr int kShiftSteps = 5;
+constexpr double kShiftDepthStep = 0.08;
+constexpr double kShiftConfirmDiameters = 0.15;
 /// texture_check: a refined turn keeps at least this share of the held pose's contour energy.
 constexpr double kTextureCheckMinEnergyRatio = 0.9;
 /// texture_check: an unrefined turn has the held pose's outline when its colour contrast is
@@ -95,6 +102,7 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   if (relocalizer_) relocalizer_->clear();
   if (texture_) texture_->clear();
   texture_check_winner_ = -1;
+  texture_shift_winner_m_.reset();
   frames_since_learning_ = 0;
   initialized_since_last_frame_ = true;
   lost_at_frame_ = -1;
@@ -335,6 +343,9 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   const TextureAgreement held_agreement = texture_->agreement(prepared, held_pose, camera);
   const double held_correlation = held_agreement.correlation;
   if (held_agreement.points >= SurfaceTexture::kMinPoints) result.texture_correlation = held_correlation;
+  if (held_agreement.points >= SurfaceTexture::kMinPoints &&
+      shift_by_texture(frame, bgr, prepared, held_correlation, result))
+    return;
   // Turns about the object's own axes through its centre, k x step for k = 1 .. n - 1.
   const Eigen::Vector3d& center = tracker_->center_object();
   const Eigen::Vector3d held_center = held_pose * center;
@@ -409,6 +420,42 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   result.frame = chosen;
   result.color = evidence_of(colors[refined_better ? 1 : 2]);
   result.texture_corrected = true;
+}
+
+bool TrackingSession::shift_by_texture(const Frame& frame, const cv::Mat& bgr,
+                                       const PreparedFrame& prepared, double held_correlation,
+                                       SessionResult& result) {
+  const double below = params_.texture_shift_search_below;
+  if (!(below > 0.0) || !texture_->has_color_pattern() || !(held_correlation < below)) return false;
+  const PinholeCamera& camera = tracker_->camera();
+  const TrackResult& held = result.frame;
+  const double diameter_m = tracker_->diameter_m();
+  const double needed = std::max(held_correlation + params_.texture_check_margin, below);
+  const TextureShift best = texture_->best_shift(prepared, held.object_to_camera, camera,
+                                                 kShiftStepDiameters * diameter_m, kShiftSteps,
+                                                 kShiftDepthStep);
+  const bool found = best.agreement.correlation >= needed;
+  // The same shift (relative to the held pose) must be found on two consecutive searches.
+  const bool confirmed = found && texture_shift_winner_m_ &&
+                         (*texture_shift_winner_m_ - best.shift_camera_m).norm() <
+                             kShiftConfirmDiameters * diameter_m;
+  texture_shift_winner_m_.reset();
+  if (found && !confirmed) texture_shift_winner_m_ = best.shift_camera_m;
+  if (!confirmed) return false;
+  TrackResult refined = tracker_->refine_hypotheses(frame, {best.object_to_camera}, 1.0).front();
+  const SearchCandidate colors = search_->score(bgr, refined.object_to_camera, camera);
+  const TextureAgreement agreement = texture_->agreement(prepared, refined.object_to_camera, camera);
+  if (!refined.refined || agreement.points < SurfaceTexture::kMinPoints ||
+      agreement.correlation < needed ||
+      refined.energy_after < kTextureCheckMinEnergyRatio * held.energy_after ||
+      colors.contrast < params_.color_accept_ratio * monitor_.color_level())
+    return false;
+  tracker_->adopt(frame, refined);
+  result.frame = refined;
+  result.color = evidence_of(colors);
+  result.texture_corrected = true;
+  result.texture_correlation = agreement.correlation;
+  return true;
 }
 
 void TrackingSession::add_keyframe_if_due(const cv::Mat& gray, const SessionResult& result) {

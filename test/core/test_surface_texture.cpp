@@ -96,5 +96,31 @@ TEST(SurfaceTexture, AnUntexturedObjectOrAMissingOneIsNotUsed) {
   EXPECT_FALSE(plain_texture.has_color_pattern());
 }
 
+/// best_shift(): the cube shown at its pose, the held pose 3 cm to the side and 3.6 cm (8 %)
+/// too far: the learned colours disagree there, and the grid of shifts finds where they agree.
+TEST(SurfaceTexture, AShiftFindsWhereThePrintedSurfaceIs) {
+  const TextureScene scene;
+  SurfaceTexture texture(scene.mesh);
+  texture.learn(scene.frame(scene.start, 1), scene.start, scene.camera);
+  ASSERT_TRUE(texture.has_color_pattern());
+  Pose held = scene.start;
+  held.translation() += Eigen::Vector3d(0.03, -0.01, 0.08 * scene.start.translation().z());
+  const cv::Mat shown = scene.frame(scene.start, 2);
+  const PreparedFrame prepared = texture.prepare(shown, held, scene.camera);
+  const TextureAgreement at_held = texture.agreement(prepared, held, scene.camera);
+  EXPECT_LT(at_held.correlation, 0.3) << "the held pose agrees: the test shows nothing";
+  // Steps of 1 cm, 5 each way: the truth is on the grid.
+  const TextureShift best = texture.best_shift(prepared, held, scene.camera, 0.01, 5, 0.08);
+  EXPECT_GE(best.agreement.points, SurfaceTexture::kMinPoints);
+  // Tolerances: the truth is a grid point (the depth step is 8 % of the held depth, the offset
+  // 8 % of the true one: 3 mm apart); a correlation near the unshifted one's (0.9+).
+  EXPECT_GT(best.agreement.correlation, 0.8);
+  EXPECT_LT(translation_error(best.object_to_camera, scene.start), 0.005);
+  EXPECT_LT((best.shift_camera_m - (best.object_to_camera.translation() - held.translation())).norm(), 1e-12);
+  // Nothing learned: nothing found.
+  const SurfaceTexture untrained(scene.mesh);
+  EXPECT_EQ(untrained.best_shift(prepared, held, scene.camera, 0.01, 5, 0.08).agreement.points, 0);
+}
+
 }  // namespace
 }  // namespace kct

@@ -28,6 +28,13 @@ struct TextureAgreement {
   int points = 0;  ///< learned points the pose shows (facing the camera, inside the image)
 };
 
+/// The best of a grid of shifted poses (SurfaceTexture::best_shift()).
+struct TextureShift {
+  Pose object_to_camera = Pose::Identity();  ///< the shifted pose
+  Eigen::Vector3d shift_camera_m = Eigen::Vector3d::Zero();  ///< its shift, camera frame, metres
+  TextureAgreement agreement;  ///< its agreement (correlation -1, points 0 when none was scored)
+};
+
 /// A frame's neighbourhood of the object, band-passed (see SurfaceTexture::prepare()).
 struct PreparedFrame {
   cv::Mat band;   ///< CV_32FC3: fine minus coarse smoothing, at `scale` of the frame
@@ -76,6 +83,15 @@ class SurfaceTexture {
   /// Agreement of the learned colours with `prepared` (from prepare()) at `object_to_camera`.
   TextureAgreement agreement(const PreparedFrame& prepared, const Pose& object_to_camera,
                              const PinholeCamera& camera) const;
+
+  /// The pose shifted in the camera frame, laterally by -steps .. steps x `lateral_step_m` along
+  /// x and y and in depth by -1, 0, 1 x `depth_step_ratio` of its centre's depth (the unshifted
+  /// pose excluded), whose colours agree best with `prepared` over at least kMinPoints points.
+  /// A pose whose outline the contour holds a few centimetres off (after a blurred jerk, its
+  /// keypoints anchored there) is found where its printed surface is.
+  TextureShift best_shift(const PreparedFrame& prepared, const Pose& object_to_camera,
+                          const PinholeCamera& camera, double lateral_step_m, int steps,
+                          double depth_step_ratio) const;
 
  private:
 

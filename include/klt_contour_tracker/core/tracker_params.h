@@ -183,6 +183,18 @@ struct TrackerParams {
   /// painted colours, not shading). Hard + second hard set: 12.00 -> 12.17 mean AUC (can
   /// 10.30 -> 10.91), median frame time of the can 7 -> 12 ms.
   bool texture_check_every_frame = false;
+  /// ours (tracking session, 0 = off; needs texture_check_margin and an object whose learned
+  /// surface has a colour pattern, SurfaceTexture::has_color_pattern()): when texture_check
+  /// finds the held pose's surface colours correlating below this, the held pose shifted in the
+  /// camera frame (laterally up to 0.25 diameters in steps of 0.05, in depth by 8 %) is scored
+  /// against the learned colours (SurfaceTexture::best_shift()). A shift correlating at least
+  /// max(this, the held pose's + texture_check_margin) and found again on the next such frame
+  /// (within 0.15 diameters) is refined (contour only) and replaces the held pose when it still
+  /// correlates that well, keeps 0.9 of the held contour energy and passes color_accept_ratio.
+  /// texture_check's turns cannot correct a pose the contour holds a few centimetres off, with
+  /// keypoints anchored there (the photo chest after a fast move: 0.2 diameters off for 60
+  /// frames, its colours correlating at -0.1, shifted at 0.4).
+  double texture_shift_search_below = 0.0;
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline

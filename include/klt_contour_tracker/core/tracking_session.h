@@ -125,6 +125,10 @@ class TrackingSession {
   /// color_search_reach_diameters: how far (full-resolution px) from the last good pose's
   /// projected centre the object can be on this frame; 0 = anywhere.
   double search_reach_px() const;
+  /// texture_shift_search_below, from texture_check (the held pose's colours `prepared`,
+  /// correlating at `held_correlation`): true when a confirmed shift replaced the held pose.
+  bool shift_by_texture(const Frame& frame, const cv::Mat& bgr, const PreparedFrame& prepared,
+                        double held_correlation, SessionResult& result);
   void count(const SessionResult& result);
   /// feature_relocalization, on a frame the pipeline tracked (`gray` undistorted): the
   /// keyframes' features around the held pose confirm it, or replace it when they disagree.
@@ -169,6 +173,8 @@ class TrackingSession {
   /// The surface colours learned at the initial pose; null unless texture_check_margin > 0.
   std::unique_ptr<SurfaceTexture> texture_;
   int texture_check_winner_ = -1;  ///< the turn that won texture_check on the last frame
+  /// texture_shift_search_below: the shift found on the last frame it searched, if any.
+  std::optional<Eigen::Vector3d> texture_shift_winner_m_;
   int frames_since_doubt_ = 1000;  ///< frames since KLT last failed or a re-acquisition
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
