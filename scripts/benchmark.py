@@ -65,6 +65,7 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_texture_shift", "realtime", {"texture_shift_search_below": "0"}),
     # a KLT failure whose refined pose lost the colours waits for the declared loss to be searched
     ("realtime_no_extrapolated_search", "realtime", {"extrapolated_search_ratio": "0"}),
+    ("realtime_no_tracked_search", "realtime", {"tracked_search_ratio": "0"}),
     # re-acquisition searches the whole frame (not only as far as the object could have moved)
     ("realtime_no_search_reach", "realtime", {"color_search_reach_diameters": "0"}),
     # keypoints anchored after a KLT failure kept even when the frame is judged bad

@@ -1,5 +1,6 @@
 #include "klt_contour_tracker/core/tracking_session.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -33,6 +34,14 @@ constexpr double kShiftStepDiameters = 0.05;
 constexpr int kShiftSteps = 5;
 constexpr double kShiftDepthStep = 0.08;
 constexpr double kShiftConfirmDiameters = 0.15;
+/// tracked_search_ratio: the colour search's find replaces a KLT-tracked pose when its colour
+/// contrast beats the held one's by this x the contrast level and its contour energy is at
+/// least this share of the held one's and this share of the running energy level (a find with a
+/// weak outline is as often a near miss as the object: photo/toy/light was held 2-3 cm off by
+/// one instead of being declared lost and re-acquired within 0.3 cm).
+constexpr double kTrackedSearchMargin = 0.2;
+constexpr double kTrackedSearchMinEnergyRatio = 0.9;
+constexpr double kTrackedSearchMinEnergyLevel = 0.7;
 /// texture_check: a refined turn keeps at least this share of the held pose's contour energy.
 constexpr double kTextureCheckMinEnergyRatio = 0.9;
 /// texture_check: an unrefined turn has the held pose's outline when its colour contrast is
@@ -142,7 +151,7 @@ void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
 }
 
 TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched,
-                                       bool color_only) {
+                                       bool color_only, const SearchBar& bar) {
   searched = false;
   const Pose& last_good = monitor_.last_good_pose();
   if (search_ && search_->ready() && !bgr.empty() &&
@@ -202,6 +211,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     } else {
       unconfirmed_.reset();
     }
+    if (best_contrast < bar.min_contrast || best.energy_after < bar.min_energy) return TrackResult();
     if (best_contrast >= params_.color_accept_ratio * monitor_.color_level() || confirmed) {
       // The taken pose confirms the next frame's best when it is at the same place: while the
       // track stays lost, a confirmed placement is not asked to wait a frame again.
@@ -276,16 +286,22 @@ bool TrackingSession::checkable(const TrackResult& held, const cv::Mat& bgr) con
          (held.status == TrackStatus::kKeypoints || held.status == TrackStatus::kExtrapolated);
 }
 
-void TrackingSession::check_extrapolated(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
+void TrackingSession::search_if_faded(const Frame& frame, const cv::Mat& bgr, SessionResult& result,
+                                      double ratio, bool must_beat_held) {
   const TrackResult& held = result.frame;
-  if (!(params_.extrapolated_search_ratio > 0.0) || held.status != TrackStatus::kExtrapolated ||
-      !checkable(held, bgr))
-    return;
+  if (!(ratio > 0.0) || !checkable(held, bgr)) return;
   const SearchCandidate scored = search_->score(bgr, held.object_to_camera, tracker_->camera());
   result.color = evidence_of(scored);  // the held pose's colours, for use_colors
-  if (!(scored.contrast < params_.extrapolated_search_ratio * monitor_.color_level())) return;
+  const double level = monitor_.color_level();
+  if (!(scored.contrast < ratio * level)) return;
+  SearchBar bar;
+  if (must_beat_held) {
+    bar.min_contrast = scored.contrast + kTrackedSearchMargin * level;
+    bar.min_energy = std::max(kTrackedSearchMinEnergyRatio * held.energy_after,
+                              kTrackedSearchMinEnergyLevel * monitor_.energy_level());
+  }
   bool searched = false;
-  const TrackResult found = reacquire(frame, bgr, searched, true);
+  const TrackResult found = reacquire(frame, bgr, searched, true, bar);
   if (!searched) return;
   result.frame = found;
   result.searched = true;
@@ -521,9 +537,15 @@ SessionResult TrackingSession::track(const Frame& frame) {
     result.frame =
         result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
     if (!gray.empty()) use_features(frame, gray, result);
-    check_extrapolated(frame, bgr, result);
+    if (result.frame.status == TrackStatus::kExtrapolated)
+      search_if_faded(frame, bgr, result, params_.extrapolated_search_ratio, false);
     check_rotation(frame, bgr, result);  // only on tracked frames (kKeypoints, kExtrapolated)
     if (!result.rotation_corrected) check_texture(frame, bgr, result);
+    // After the checks: a turn or a shift they found is the held pose's own correction, while
+    // the colour search may take another place.
+    if (result.frame.status == TrackStatus::kKeypoints && !result.rotation_corrected &&
+        !result.texture_corrected)
+      search_if_faded(frame, bgr, result, params_.tracked_search_ratio, true);
   }
   use_colors(bgr, result);
   if (texture_ && !bgr.empty() && result.frame.status == TrackStatus::kInitialized)

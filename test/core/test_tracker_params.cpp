@@ -119,7 +119,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 84u);
+  EXPECT_EQ(fields.size(), 85u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

@@ -358,6 +358,61 @@ TEST(TrackingSession, AJumpIsSearchedForOnTheFrameItHappens) {
   }
 }
 
+/// tracked_search_ratio: the red box jumps 18 cm sideways and the jump frame is not searched
+/// (extrapolated_search_ratio off) and its keypoints, laid at the held pose, are kept
+/// (drop_unconfirmed_anchors off): they lie on the textured background, which KLT then tracks
+/// perfectly while the box is elsewhere. With the ratio the colour search runs on such a
+/// KLT-tracked frame and its find, beating the held pose's colours, replaces it before the loss
+/// is declared; without it the held pose stays on the background.
+TEST(TrackingSession, ATrackHeldOnTheBackgroundIsSearchedForBeforeTheLoss) {
+  const ColourScene scene;
+  const Pose away = test::move(scene.start, 8.0, {0.2, 1.0, 0.3}, {-0.15, 0.1, 0.0});
+  TrackerParams params = quick_realtime();
+  ASSERT_GT(params.tracked_search_ratio, 0.0) << "realtime searches tracked frames";
+  params.extrapolated_search_ratio = 0.0;
+  params.drop_unconfirmed_anchors = false;
+  params.color_search_reach_diameters = 0.0;  // a jump beyond the reach, as in the test above
+  for (const double ratio : {0.0, params.tracked_search_ratio}) {
+    params.tracked_search_ratio = ratio;
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.initialize(scene.start);
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033) {
+      const SessionResult r = session.track(
+          {test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
+      ASSERT_EQ(r.state, TrackState::kTracking) << i;
+    }
+    const SessionResult jump = session.track(
+        {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 30), stamp});
+    stamp += 0.033;
+    ASSERT_FALSE(jump.searched) << "the jump frame is not searched here";
+    ASSERT_GT(translation_error(jump.frame.object_to_camera, away), 0.05) << "no jump: no test";
+    // The next two frames, before the loss can be declared (lost_after_bad_frames = 5).
+    int keypoint_frames = 0;
+    SessionResult found;
+    for (int i = 0; i < 2 && !found.searched; ++i, stamp += 0.033) {
+      const SessionResult r = session.track(
+          {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 31 + i), stamp});
+      EXPECT_FALSE(r.reacquiring) << i;
+      // A searched frame was KLT-tracked: only such frames are searched here.
+      if (r.frame.keypoints.success || r.searched) ++keypoint_frames;
+      found = r;
+    }
+    EXPECT_GT(keypoint_frames, 0) << "KLT must hold the background: no test";
+    if (ratio == 0.0) {
+      EXPECT_FALSE(found.searched);
+      EXPECT_GT(translation_error(found.frame.object_to_camera, away), 0.05);
+    } else {
+      ASSERT_TRUE(found.searched);
+      EXPECT_EQ(found.frame.status, TrackStatus::kReacquired);
+      // Tolerance: 1 cm and 3 deg, as the other re-acquisition tests.
+      EXPECT_LT(translation_error(found.frame.object_to_camera, away), 0.01);
+      EXPECT_LT(rotation_error_deg(found.frame.object_to_camera, away), 3.0);
+    }
+  }
+}
+
 /// feature_relocalization: a textured box is hidden, then shown again 12 cm to the side and 8 deg
 /// turned (far outside the refinement's reach); with the colour search off, only the keyframe
 /// features of the initial pose can find it: re-acquired within 10 frames with, never without.

@@ -33,7 +33,8 @@ struct SessionResult {
   double quality = 0.0;      ///< the monitor's score in [0, 1]; 0 when the frame has no pose
   bool good = false;         ///< quality >= min_quality (and the frame has a pose)
   bool reacquiring = false;  ///< the frame ran re-acquisition instead of tracking
-  /// Re-acquisition started from the colour search's best placement (color_search).
+  /// The pose came from the colour search's best placement (color_search): a re-acquisition
+  /// while lost, or a held track replaced by extrapolated_search_ratio / tracked_search_ratio.
   bool searched = false;
   /// The pose came from the feature relocalizer (feature_relocalization): a re-acquisition
   /// while lost, or a held track it replaced.
@@ -67,6 +68,13 @@ struct SessionStatistics {
   /// For each re-acquisition: frames from the one that declared the loss to the one that
   /// declared the track good again (>= recover_after_good_frames).
   std::vector<int> frames_to_reacquire;
+};
+
+/// What the session's colour search must reach for its best hypothesis to replace a held pose
+/// (tracked_search_ratio); the defaults ask nothing.
+struct SearchBar {
+  double min_contrast = -std::numeric_limits<double>::infinity();  ///< colour contrast
+  double min_energy = -std::numeric_limits<double>::infinity();    ///< refined contour energy
 };
 
 /// Tracks one rigid object in one camera's stream with loss detection and re-acquisition.
@@ -118,10 +126,10 @@ class TrackingSession {
 
  private:
   /// Re-acquisition while lost: the colour search's hypotheses, else (not `color_only`) a
-  /// refinement around the last good pose. `color_only` and nothing found: a default result
-  /// (searched false).
+  /// refinement around the last good pose. `color_only` and nothing found (or nothing above
+  /// `bar`): a default result (searched false).
   TrackResult reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched,
-                        bool color_only = false);
+                        bool color_only = false, const SearchBar& bar = SearchBar());
   /// color_search_reach_diameters: how far (full-resolution px) from the last good pose's
   /// projected centre the object can be on this frame; 0 = anywhere.
   double search_reach_px() const;
@@ -139,9 +147,12 @@ class TrackingSession {
   /// The tracker continues from the relocalizer's `object_to_camera`; `result` reports it
   /// (kReacquired, relocalized).
   void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, SessionResult& result);
-  /// extrapolated_search_ratio: a frame where KLT failed and the refinement lost the colours
-  /// is searched for the object at once.
-  void check_extrapolated(const Frame& frame, const cv::Mat& bgr, SessionResult& result);
+  /// extrapolated_search_ratio (a frame where KLT failed) and tracked_search_ratio (a frame KLT
+  /// tracked): when the held pose's colour contrast is below `ratio` x its level, the frame is
+  /// searched for the object at once. `must_beat_held`: the find replaces the held pose only
+  /// when it beats it (see TrackerParams::tracked_search_ratio).
+  void search_if_faded(const Frame& frame, const cv::Mat& bgr, SessionResult& result,
+                       double ratio, bool must_beat_held);
   /// rotation_check's and texture_check's common ground: the colour model is ready, the frame
   /// is in colour and `held` is a refined tracked pose (kKeypoints, kExtrapolated).
   bool checkable(const TrackResult& held, const cv::Mat& bgr) const;
