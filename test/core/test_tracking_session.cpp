@@ -199,6 +199,18 @@ struct ColourScene {
   }
 };
 
+/// Tracks the red box 8 frames at its start, each of which must end TRACKING; `stamp` is
+/// advanced past them.
+void track_start(TrackingSession& session, const ColourScene& scene, double& stamp) {
+  session.set_camera(scene.camera);
+  session.initialize(scene.start);
+  for (int i = 0; i < 8; ++i, stamp += 0.033) {
+    const SessionResult r = session.track(
+        {test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
+    ASSERT_EQ(r.state, TrackState::kTracking) << i;
+  }
+}
+
 /// What a correcting check (rotation_check, texture_check) did while an object came back.
 struct CheckRun {
   SessionResult last;        ///< the last frame's result
@@ -334,14 +346,8 @@ TEST(TrackingSession, AJumpIsSearchedForOnTheFrameItHappens) {
   for (const double ratio : {0.0, params.extrapolated_search_ratio}) {
     params.extrapolated_search_ratio = ratio;
     TrackingSession session(scene.mesh, params);
-    session.set_camera(scene.camera);
-    session.initialize(scene.start);
     double stamp = 0.0;
-    for (int i = 0; i < 8; ++i, stamp += 0.033) {
-      const SessionResult r = session.track(
-          {test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
-      ASSERT_EQ(r.state, TrackState::kTracking) << i;
-    }
+    ASSERT_NO_FATAL_FAILURE(track_start(session, scene, stamp));
     const SessionResult jump = session.track(
         {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 30), stamp});
     EXPECT_FALSE(jump.reacquiring) << "the session was not lost before the jump";
@@ -375,14 +381,8 @@ TEST(TrackingSession, ATrackHeldOnTheBackgroundIsSearchedForBeforeTheLoss) {
   for (const double ratio : {0.0, params.tracked_search_ratio}) {
     params.tracked_search_ratio = ratio;
     TrackingSession session(scene.mesh, params);
-    session.set_camera(scene.camera);
-    session.initialize(scene.start);
     double stamp = 0.0;
-    for (int i = 0; i < 8; ++i, stamp += 0.033) {
-      const SessionResult r = session.track(
-          {test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
-      ASSERT_EQ(r.state, TrackState::kTracking) << i;
-    }
+    ASSERT_NO_FATAL_FAILURE(track_start(session, scene, stamp));
     const SessionResult jump = session.track(
         {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 30), stamp});
     stamp += 0.033;
