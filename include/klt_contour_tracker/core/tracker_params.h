@@ -182,10 +182,9 @@ struct TrackerParams {
   /// texture_check left as it was), the colour search runs as while lost; its pose replaces the
   /// held one only when it beats the held pose: colour contrast higher by 0.2 x the level and
   /// passing color_accept_ratio, contour energy at least 0.9 x the held one's and 0.7 x the
-  /// energy level. KLT's anchors can
-  /// hold a wrong pose as well as a right one (after a jump they are laid on the background,
-  /// which then "tracks" perfectly); the colours tell, and the search finds the object again
-  /// before the loss is declared.
+  /// energy level. KLT's anchors can hold a wrong pose as well as a right one (after a jump they
+  /// are laid on the background, which then "tracks" perfectly); the colours tell, and the
+  /// search finds the object again before the loss is declared.
   double tracked_search_ratio = 0.0;
   double texture_check_step_deg = 10.0;  ///< see texture_check_margin
   /// texture_check runs on every tracked frame, not only in rotation_check's window, when the
