@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <nlopt.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "klt_contour_tracker/core/pose_parametrization.h"
 #include "klt_contour_tracker/core/renderer.h"
 #include "klt_contour_tracker/core/surface_anchor.h"
 
@@ -25,6 +27,13 @@ constexpr double kMinBandMedian = 3.0;
 /// (root mean square distance from the mean; benchmark objects: textured can and chest
 /// 0.20-0.48, uniformly orange toy 0.08-0.10, grey castle 0.01).
 constexpr double kMinChromaStd = 0.15;
+
+/// align(): BOBYQA's first step and stopping tolerance, in shares of the bounds.
+constexpr double kAlignInitialStep = 0.15;
+constexpr double kAlignTolerance = 1e-3;
+/// align(): the coarse stage's further smoothing of the band, its pixels (the object spans
+/// kWorkDiameterPx there: 4 % of its size; 2 and 4 px left the test's cube 3-15 deg off).
+constexpr double kAlignWideSigmaPx = 5.0;
 
 /// Bilinear value of a CV_32FC3 image at a sub-pixel point at least 1 px inside it.
 Eigen::Vector3f sample(const cv::Mat& image, double x, double y) {
@@ -169,6 +178,84 @@ TextureShift SurfaceTexture::best_shift(const PreparedFrame& prepared, const Pos
           best.agreement = a;
         }
       }
+  return best;
+}
+
+TextureAlignment SurfaceTexture::align(const PreparedFrame& prepared, const Pose& object_to_camera,
+                                       const PinholeCamera& camera, double max_turn_rad,
+                                       double max_shift_m, int max_evaluations) const {
+  TextureAlignment best;
+  best.object_to_camera = object_to_camera;
+  best.agreement = agreement(prepared, object_to_camera, camera);
+  best.evaluations = 1;
+  if (best.agreement.points < kMinPoints || !(max_turn_rad > 0.0) || !(max_shift_m > 0.0) ||
+      max_evaluations < 2)
+    return best;
+  // The six pose parameters around the given pose, scaled to [-1, 1] by the bounds. BOBYQA
+  // (derivative-free, bounded, a quadratic model): the correlation over a few hundred sampled
+  // points is piecewise smooth in the pose, and a numeric gradient would cost 12 agreements.
+  const PoseParametrization parametrization(object_to_camera, center_object_);
+  struct Problem {
+    const SurfaceTexture* self;
+    const PreparedFrame* prepared;
+    const PinholeCamera* camera;
+    const PoseParametrization* parametrization;
+    double turn_rad, shift_m;
+    TextureAlignment* best;
+    Pose pose_of(const double* x) const {
+      Vector6d z;
+      for (int i = 0; i < 6; ++i) z[i] = x[i] * (i < 3 ? turn_rad : shift_m);
+      return parametrization->apply(z);
+    }
+  };
+  const auto objective = [](unsigned, const double* x, double*, void* data) {
+    const auto* p = static_cast<const Problem*>(data);
+    const Pose pose = p->pose_of(x);
+    const TextureAgreement a = p->self->agreement(*p->prepared, pose, *p->camera);
+    ++p->best->evaluations;
+    if (a.points < kMinPoints) return -1.0;  // too little of the surface shown to compare
+    if (a.correlation > p->best->agreement.correlation) {
+      p->best->object_to_camera = pose;
+      p->best->agreement = a;
+    }
+    return a.correlation;
+  };
+  // Maximizes the agreement with `band` from `x` (updated to the end point) in at most
+  // `budget` agreements, the best pose into `stage`.
+  const auto maximize = [&](const PreparedFrame& band, TextureAlignment& stage, int budget,
+                            std::vector<double>& x) {
+    if (budget < 2) return;
+    Problem problem{this, &band, &camera, &parametrization, max_turn_rad, max_shift_m, &stage};
+    nlopt::opt opt(nlopt::LN_BOBYQA, 6);
+    opt.set_lower_bounds(std::vector<double>(6, -1.0));
+    opt.set_upper_bounds(std::vector<double>(6, 1.0));
+    opt.set_max_objective(objective, &problem);
+    opt.set_initial_step(kAlignInitialStep);
+    opt.set_maxeval(budget);
+    opt.set_xtol_rel(kAlignTolerance);
+    double value = 0.0;
+    try {
+      opt.optimize(x, value);
+    } catch (const std::exception&) {
+      // roundoff_limited and the like: the best point seen is kept.
+    }
+  };
+  // Coarse to fine: first on the band smoothed further, whose correlation peak is wider (a
+  // random-textured cube turned 9-15 deg is found from there, not on the band alone), then on
+  // the band itself from the coarse stage's best pose, with the rest of the budget.
+  PreparedFrame wide = prepared;
+  wide.band = cv::Mat();  // its own pixels: the copy shares prepared's
+  cv::GaussianBlur(prepared.band, wide.band, cv::Size(), kAlignWideSigmaPx);
+  TextureAlignment coarse;
+  coarse.object_to_camera = object_to_camera;
+  coarse.agreement = agreement(wide, object_to_camera, camera);
+  std::vector<double> x(6, 0.0);
+  maximize(wide, coarse, max_evaluations / 2 - 1, x);
+  best.evaluations += 1 + coarse.evaluations;
+  const Vector6d z = parametrization.parameters_of(coarse.object_to_camera);
+  for (int i = 0; i < 6; ++i)
+    x[i] = std::clamp(z[i] / (i < 3 ? max_turn_rad : max_shift_m), -1.0, 1.0);
+  maximize(prepared, best, max_evaluations - best.evaluations, x);
   return best;
 }
 

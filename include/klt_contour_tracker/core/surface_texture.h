@@ -35,6 +35,14 @@ struct TextureShift {
   TextureAgreement agreement;  ///< its agreement (correlation -1, points 0 when none was scored)
 };
 
+/// The pose near a given one whose colours agree best (SurfaceTexture::align()).
+struct TextureAlignment {
+  Pose object_to_camera =
+      Pose::Identity();        ///< the best pose found (the given one if none was better)
+  TextureAgreement agreement;  ///< its agreement
+  int evaluations = 0;         ///< agreements computed
+};
+
 /// A frame's neighbourhood of the object, band-passed (see SurfaceTexture::prepare()).
 struct PreparedFrame {
   cv::Mat band;   ///< CV_32FC3: fine minus coarse smoothing, at `scale` of the frame
@@ -83,6 +91,18 @@ class SurfaceTexture {
   /// Agreement of the learned colours with `prepared` (from prepare()) at `object_to_camera`.
   TextureAgreement agreement(const PreparedFrame& prepared, const Pose& object_to_camera,
                              const PinholeCamera& camera) const;
+
+  /// The pose within `max_turn_rad` (turns about the object's centre, about each camera axis)
+  /// and `max_shift_m` (of the centre, along each camera axis) of `object_to_camera` whose
+  /// colours agree best with `prepared`, by a local search from `object_to_camera` of at most
+  /// `max_evaluations` agreements, coarse to fine (first on the band smoothed by a further 4 %
+  /// of the object's size, whose correlation peak is wider, then on the band). A pose KLT's anchors
+  /// hold 10-20 deg off about no axis of the object's (after an occlusion or a blurred jerk:
+  /// best_shift() and the texture check's turns about the object's axes miss it) is found where its
+  /// surface pattern is. Never worse than `object_to_camera`'s own agreement.
+  TextureAlignment align(const PreparedFrame& prepared, const Pose& object_to_camera,
+                         const PinholeCamera& camera, double max_turn_rad, double max_shift_m,
+                         int max_evaluations) const;
 
   /// The pose shifted in the camera frame, laterally by -steps .. steps x `lateral_step_m` along
   /// x and y and in depth by -1, 0, 1 x `depth_step_ratio` of its centre's depth (the unshifted
