@@ -63,6 +63,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_texture_check_in_window", "realtime", {"texture_check_every_frame": "false"}),
     # a held pose whose surface colours disagree is not searched for by shifts
     ("realtime_no_texture_shift", "realtime", {"texture_shift_search_below": "0"}),
+    # ... nor turned and shifted to where they agree (the local alignment)
+    ("realtime_no_texture_align", "realtime", {"texture_align_below": "0"}),
     # a KLT failure whose refined pose lost the colours waits for the declared loss to be searched
     ("realtime_no_extrapolated_search", "realtime", {"extrapolated_search_ratio": "0"}),
     ("realtime_no_tracked_search", "realtime", {"tracked_search_ratio": "0"}),

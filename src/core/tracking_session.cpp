@@ -42,6 +42,11 @@ constexpr double kShiftConfirmDiameters = 0.15;
 constexpr double kTrackedSearchMargin = 0.2;
 constexpr double kTrackedSearchMinEnergyRatio = 0.9;
 constexpr double kTrackedSearchMinEnergyLevel = 0.7;
+/// texture_align_below: the alignment's bounds (turn about the centre, degrees; shift of the
+/// centre, diameters) and its budget of agreements.
+constexpr double kAlignMaxTurnDeg = 20.0;
+constexpr double kAlignMaxShiftDiameters = 0.1;
+constexpr int kAlignMaxEvaluations = 300;
 /// texture_check: a refined turn keeps at least this share of the held pose's contour energy.
 constexpr double kTextureCheckMinEnergyRatio = 0.9;
 /// texture_check: an unrefined turn has the held pose's outline when its colour contrast is
@@ -349,10 +354,12 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
 
 void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, SessionResult& result) {
   const TrackResult& held = result.frame;
-  if (!texture_ || !texture_->ready() || !checkable(held, bgr) ||
-      (frames_since_doubt_ > params_.rotation_check_frames &&
-       !(params_.texture_check_every_frame && texture_->has_color_pattern())))
-    return;
+  if (!texture_ || !texture_->ready() || !checkable(held, bgr)) return;
+  // The turns about the object's axes run in rotation_check's window (every frame for a colour
+  // pattern); the alignment, when on, on every frame.
+  const bool turns_due = frames_since_doubt_ <= params_.rotation_check_frames ||
+                         (params_.texture_check_every_frame && texture_->has_color_pattern());
+  if (!turns_due && !(params_.texture_align_below > 0.0)) return;
   const PinholeCamera& camera = tracker_->camera();
   const Pose& held_pose = held.object_to_camera;
   const PreparedFrame prepared = texture_->prepare(bgr, held_pose, camera);
@@ -362,6 +369,10 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   if (held_agreement.points >= SurfaceTexture::kMinPoints &&
       shift_by_texture(frame, bgr, prepared, held_correlation, result))
     return;
+  if (held_agreement.points >= SurfaceTexture::kMinPoints &&
+      align_by_texture(frame, bgr, prepared, held_correlation, result))
+    return;
+  if (!turns_due) return;
   // Turns about the object's own axes through its centre, k x step for k = 1 .. n - 1.
   const Eigen::Vector3d& center = tracker_->center_object();
   const Eigen::Vector3d held_center = held_pose * center;
@@ -438,6 +449,25 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   result.texture_corrected = true;
 }
 
+bool TrackingSession::align_by_texture(const Frame& frame, const cv::Mat& bgr,
+                                       const PreparedFrame& prepared, double held_correlation,
+                                       SessionResult& result) {
+  const double below = params_.texture_align_below;
+  if (!(below > 0.0) || !(held_correlation < below)) return false;
+  const PinholeCamera& camera = tracker_->camera();
+  const TrackResult& held = result.frame;
+  const TextureAlignment aligned =
+      texture_->align(prepared, held.object_to_camera, camera, kAlignMaxTurnDeg * M_PI / 180.0,
+                      kAlignMaxShiftDiameters * tracker_->diameter_m(), kAlignMaxEvaluations);
+  const double needed =
+      std::max(held_correlation + params_.texture_check_margin, kTextureCheckMinCorrelation);
+  if (!(aligned.agreement.correlation >= needed)) return false;
+  // Refined without the shift search (the place is the aligned one's): the outline alone may
+  // pull it back to the held pose, so the surface is asked again.
+  return take_if_surface_agrees(frame, bgr, prepared, aligned.object_to_camera, needed, false,
+                                result);
+}
+
 bool TrackingSession::shift_by_texture(const Frame& frame, const cv::Mat& bgr,
                                        const PreparedFrame& prepared, double held_correlation,
                                        SessionResult& result) {
@@ -458,9 +488,19 @@ bool TrackingSession::shift_by_texture(const Frame& frame, const cv::Mat& bgr,
   texture_shift_winner_m_.reset();
   if (found && !confirmed) texture_shift_winner_m_ = best.shift_camera_m;
   if (!confirmed) return false;
-  TrackResult refined = tracker_->refine_hypotheses(frame, {best.object_to_camera}, 1.0).front();
+  return take_if_surface_agrees(frame, bgr, prepared, best.object_to_camera, needed, true, result);
+}
+
+bool TrackingSession::take_if_surface_agrees(const Frame& frame, const cv::Mat& bgr,
+                                             const PreparedFrame& prepared, const Pose& found,
+                                             double needed, bool shift_search,
+                                             SessionResult& result) {
+  const TrackResult& held = result.frame;
+  const PinholeCamera& camera = tracker_->camera();
+  TrackResult refined = tracker_->refine_hypotheses(frame, {found}, 1.0, shift_search).front();
   const SearchCandidate colors = search_->score(bgr, refined.object_to_camera, camera);
-  const TextureAgreement agreement = texture_->agreement(prepared, refined.object_to_camera, camera);
+  const TextureAgreement agreement =
+      texture_->agreement(prepared, refined.object_to_camera, camera);
   if (!refined.refined || agreement.points < SurfaceTexture::kMinPoints ||
       agreement.correlation < needed ||
       refined.energy_after < kTextureCheckMinEnergyRatio * held.energy_after ||

@@ -43,6 +43,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.texture_check_margin, 0.0);
   EXPECT_FALSE(p.texture_check_every_frame);
   EXPECT_DOUBLE_EQ(p.texture_shift_search_below, 0.0);
+  EXPECT_DOUBLE_EQ(p.texture_align_below, 0.0);
 }
 
 TEST(TrackerParams, CueFieldsAreValidated) {
@@ -119,7 +120,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 85u);
+  EXPECT_EQ(fields.size(), 86u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

@@ -204,6 +204,17 @@ struct TrackerParams {
   /// keypoints anchored there (the photo chest after a fast move: 0.2 diameters off for 60
   /// frames, its colours correlating at -0.1, shifted at 0.4).
   double texture_shift_search_below = 0.0;
+  /// ours (tracking session, 0 = off; needs texture_check_margin and a learned surface,
+  /// SurfaceTexture::ready()): on every tracked frame the held pose's surface colours are
+  /// correlated with the learned ones; below this, the pose within 20 deg and 0.1 diameters of
+  /// the held one whose colours correlate best is searched for (SurfaceTexture::align(), coarse
+  /// to fine, at most 300 agreements), refined (contour only, no shift search) and taken when
+  /// it still correlates at least max(0.5, the held pose's + texture_check_margin), keeps 0.9
+  /// of the held contour energy and passes color_accept_ratio. KLT's anchors hold a pose turned
+  /// 10-20 deg about no axis of the object's as firmly as the right one (the toy after an
+  /// occlusion: 17 deg off for 30 frames, correlating at -0.1; aligned at 0.8); texture_check's
+  /// turns about the object's axes and the shifts miss it.
+  double texture_align_below = 0.0;
 
   // ---- Contour energy refinement (Sec. 3.2-3.5, supplement) ---------------------------------
   bool refine = true;                      ///< false = the `klt_only` baseline

@@ -137,6 +137,17 @@ class TrackingSession {
   /// correlating at `held_correlation`): true when a confirmed shift replaced the held pose.
   bool shift_by_texture(const Frame& frame, const cv::Mat& bgr, const PreparedFrame& prepared,
                         double held_correlation, SessionResult& result);
+  /// texture_align_below, from texture_check (as shift_by_texture()): true when the aligned
+  /// pose replaced the held one.
+  bool align_by_texture(const Frame& frame, const cv::Mat& bgr, const PreparedFrame& prepared,
+                        double held_correlation, SessionResult& result);
+  /// shift_by_texture() and align_by_texture(): `found` refined (contour only; with the
+  /// shift search or not) replaces the held pose in `result` when the refined pose's colours
+  /// still correlate at least `needed` with the surface in `prepared`, it keeps 0.9 of the held
+  /// contour energy and passes color_accept_ratio. True when it did.
+  bool take_if_surface_agrees(const Frame& frame, const cv::Mat& bgr, const PreparedFrame& prepared,
+                              const Pose& found, double needed, bool shift_search,
+                              SessionResult& result);
   void count(const SessionResult& result);
   /// feature_relocalization, on a frame the pipeline tracked (`gray` undistorted): the
   /// keyframes' features around the held pose confirm it, or replace it when they disagree.
