@@ -540,26 +540,33 @@ TEST(TrackingSession, RotationCheckCorrectsAWrongRotationTheTrackHolds) {
     }
 }
 
+/// The texture tests' scene: a randomly textured 10 cm cube (centred at its origin) over the
+/// colour tests' background.
+struct CubeScene {
+  std::shared_ptr<Mesh> cube = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1));
+  Renderer renderer{cube};
+  PinholeCamera camera = test::make_camera();
+  cv::Mat background = test::make_background(camera.size(), 5) * 0.5 + cv::Scalar(90, 70, 40);
+  Pose start = test::make_pose(0.45);
+};
+
 /// texture_check: a textured cube vanishes for a frame (KLT fails) and comes back at the same
 /// place turned 90 deg about its own z axis: the same outline and colours, another face
 /// pattern. Without the check the track holds the unturned pose (reported good); with it the
 /// learned surface colours find the turn on two consecutive frames and it replaces the pose.
 TEST(TrackingSession, TextureCheckFindsATurnAboutTheObjectsAxis) {
-  const auto cube = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1));
-  const Renderer renderer(cube);
-  const PinholeCamera camera = test::make_camera();
-  const cv::Mat background = test::make_background(camera.size(), 5) * 0.5 + cv::Scalar(90, 70, 40);
-  const Pose start = test::make_pose(0.45);
+  const CubeScene scene;
+  const Pose& start = scene.start;
   ASSERT_GT(make_preset("realtime").texture_check_margin, 0.0) << "realtime checks the texture";
   for (const double turn_deg : {0.0, 90.0})
     for (const bool check : {false, true}) {
       TrackerParams params = quick_realtime();
       if (!check) params.texture_check_margin = 0.0;
-      TrackingSession session(cube, params);
+      TrackingSession session(scene.cube, params);
       Pose truth = start;
       truth.linear() = start.linear() * Eigen::AngleAxisd(turn_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      const CheckRun run =
-          hide_and_show(session, renderer, camera, background, start, truth, &SessionResult::texture_corrected);
+      const CheckRun run = hide_and_show(session, scene.renderer, scene.camera, scene.background,
+                                         start, truth, &SessionResult::texture_corrected);
       const SessionResult& r = run.last;
       const int first_corrected = run.first_corrected, corrections = run.corrections;
       const std::string what = "turn " + std::to_string(turn_deg) + (check ? " with" : " without") + " the check";
@@ -591,14 +598,11 @@ TEST(TrackingSession, TextureCheckFindsATurnAboutTheObjectsAxis) {
 /// texture_align_below: a textured cube vanishes for a frame (KLT fails) and comes back at the
 /// same place turned 15 deg about an axis that is none of its own (camera x and y mixed). The
 /// check's turns about the cube's axes and rotation_check's turns about the camera's (off here)
-/// do not apply; without the alignment the track holds a pose turned part of the way (reported
-/// good); with it the surface colours find the turn and it replaces the pose.
+/// do not apply; without the alignment the track holds the unturned pose (reported good); with
+/// it the surface colours find the turn and it replaces the pose.
 TEST(TrackingSession, TextureAlignmentFindsATurnAboutAnyAxis) {
-  const auto cube = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1));
-  const Renderer renderer(cube);
-  const PinholeCamera camera = test::make_camera();
-  const cv::Mat background = test::make_background(camera.size(), 5) * 0.5 + cv::Scalar(90, 70, 40);
-  const Pose start = test::make_pose(0.45);
+  const CubeScene scene;
+  const Pose& start = scene.start;
   const Pose truth =
       test::move(start, 15.0, Eigen::Vector3d(1.0, 1.0, 0.0), Eigen::Vector3d::Zero());
   ASSERT_GT(make_preset("realtime").texture_align_below, 0.0) << "realtime aligns the texture";
@@ -606,9 +610,9 @@ TEST(TrackingSession, TextureAlignmentFindsATurnAboutAnyAxis) {
     TrackerParams params = quick_realtime();
     params.rotation_check_deg = 0.0;
     params.texture_align_below = align ? 0.3 : 0.0;
-    TrackingSession session(cube, params);
-    const CheckRun run = hide_and_show(session, renderer, camera, background, start, truth,
-                                       &SessionResult::texture_corrected);
+    TrackingSession session(scene.cube, params);
+    const CheckRun run = hide_and_show(session, scene.renderer, scene.camera, scene.background,
+                                       start, truth, &SessionResult::texture_corrected);
     const SessionResult& r = run.last;
     const std::string what = align ? "with the alignment" : "without the alignment";
     ASSERT_EQ(r.state, TrackState::kTracking) << what;
