@@ -295,13 +295,16 @@ void TrackingSession::search_if_faded(const Frame& frame, const cv::Mat& bgr, Se
                                       double ratio, bool must_beat_held) {
   const TrackResult& held = result.frame;
   if (!(ratio > 0.0) || !checkable(held, bgr)) return;
-  const SearchCandidate scored = search_->score(bgr, held.object_to_camera, tracker_->camera());
-  result.color = evidence_of(scored);  // the held pose's colours, for use_colors
+  // The held pose's colours, for use_colors; a check that ran before (check_rotation) has
+  // scored them already.
+  if (!result.color.valid)
+    result.color = evidence_of(search_->score(bgr, held.object_to_camera, tracker_->camera()));
+  const double held_contrast = result.color.contrast;
   const double level = monitor_.color_level();
-  if (!(scored.contrast < ratio * level)) return;
+  if (!(held_contrast < ratio * level)) return;
   SearchBar bar;
   if (must_beat_held) {
-    bar.min_contrast = scored.contrast + kTrackedSearchMargin * level;
+    bar.min_contrast = held_contrast + kTrackedSearchMargin * level;
     bar.min_energy = std::max(kTrackedSearchMinEnergyRatio * held.energy_after,
                               kTrackedSearchMinEnergyLevel * monitor_.energy_level());
   }
