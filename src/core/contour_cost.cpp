@@ -101,21 +101,33 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
            cv::Rect2d(0, 0, camera.width(), camera.height());
   }
 
+  // Each level's region (level px): empty when too small to differentiate.
+  std::vector<cv::Rect> rois(frame.levels.size());
+  for (std::size_t l = 0; l < rois.size(); ++l) {
+    const PyramidLevel& level = frame.levels[l];
+    rois[l] = cv::Rect(static_cast<int>(std::floor(full.x * level.scale)),
+                       static_cast<int>(std::floor(full.y * level.scale)),
+                       static_cast<int>(std::ceil(full.width * level.scale)) + 2,
+                       static_cast<int>(std::ceil(full.height * level.scale)) + 2) &
+              cv::Rect(0, 0, level.gray.cols, level.gray.rows);
+    if (rois[l].width < 3 || rois[l].height < 3) rois[l] = cv::Rect();
+  }
+  // The same pyramid (the same buffers, held by levels_source_) and the same regions: the
+  // derivatives are those computed last time.
+  bool same = levels_.size() == frame.levels.size() && levels_source_.size() == frame.levels.size();
+  for (std::size_t l = 0; same && l < rois.size(); ++l)
+    same = levels_source_[l].data == frame.levels[l].gray.data &&
+           levels_source_[l].size() == frame.levels[l].gray.size() && levels_[l].roi == rois[l];
+  if (same) return;
+  levels_source_.clear();
   levels_.assign(frame.levels.size(), LevelImages());
   workers_->parallel_for(static_cast<int>(frame.levels.size()), [&](int l) {
     const PyramidLevel& level = frame.levels[l];
     LevelImages& out = levels_[l];
     const cv::Rect bounds(0, 0, level.gray.cols, level.gray.rows);
-    cv::Rect roi(static_cast<int>(std::floor(full.x * level.scale)),
-                 static_cast<int>(std::floor(full.y * level.scale)),
-                 static_cast<int>(std::ceil(full.width * level.scale)) + 2,
-                 static_cast<int>(std::ceil(full.height * level.scale)) + 2);
-    roi &= bounds;
+    const cv::Rect roi = rois[l];
     out.roi = roi;
-    if (roi.width < 3 || roi.height < 3) {
-      out.roi = cv::Rect();
-      return;
-    }
+    if (roi.empty()) return;
     // Blur on a slightly larger window so that the region's border is not biased by padding.
     const int pad = static_cast<int>(std::ceil(3.0 * blur_sigma_px_)) + 2;
     const cv::Rect outer = cv::Rect(roi.x - pad, roi.y - pad, roi.width + 2 * pad,
@@ -136,6 +148,7 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
     cv::magnitude(out.gx, out.gy, magnitude);
     out.contrast = std::max(1e-3, kContrastFactor * cv::mean(magnitude)[0]);
   });
+  for (const PyramidLevel& level : frame.levels) levels_source_.push_back(level.gray);
 }
 
 double ContourCost::contrast_scale() const {

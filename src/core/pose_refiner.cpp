@@ -83,8 +83,19 @@ void PoseRefiner::prepare_frame(const cv::Mat& gray, const PinholeCamera& camera
                                 const Pose& predicted, const cv::Mat& bgr) {
   if (params_.optimizer != "coarse_to_fine") return;
   const auto start = std::chrono::steady_clock::now();
+  // The same frame as last time (the session refines several hypotheses on one frame): its
+  // pyramid is kept. The levels hold the frame's buffer, so it cannot be another frame's.
+  std::vector<PyramidLevel> levels;
+  const PinholeCamera& kept = cost_frame_.levels.empty() ? camera : cost_frame_.levels[0].camera;
+  if (static_cast<int>(cost_frame_.levels.size()) == params_.pyramid_levels &&
+      cost_frame_.levels[0].gray.data == gray.data &&
+      cost_frame_.levels[0].gray.size() == gray.size() && kept.fx() == camera.fx() &&
+      kept.fy() == camera.fy() && kept.cx() == camera.cx() && kept.cy() == camera.cy())
+    levels = std::move(cost_frame_.levels);
+  else
+    levels = make_pyramid(gray, camera, params_.pyramid_levels);
   cost_frame_ = PoseCostFrame();
-  cost_frame_.levels = make_pyramid(gray, camera, params_.pyramid_levels);
+  cost_frame_.levels = std::move(levels);
   cost_frame_.predicted_object_to_camera = cost_frame_.preliminary_object_to_camera = predicted;
   cost_frame_.center_object = center_object_;
   cost_frame_.bgr = bgr;

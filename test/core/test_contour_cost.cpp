@@ -154,6 +154,30 @@ TEST_F(ContourCostTest, EnergyIsHighestAndCostLowestAtTheTruePose) {
   EXPECT_GT(cost.evaluate(truth_, nullptr, nullptr), -3.0);
 }
 
+TEST_F(ContourCostTest, AnotherFrameOfTheSameSizeAndRegionIsDifferentiatedAgain) {
+  // begin_frame() keeps the last frame's derivatives when given the same pyramid and region
+  // again (the session refines many hypotheses on one frame); a new frame must not get them.
+  ContourCost cost(extractor_, 2.0, 1.0);
+  cost.begin_frame(frame_);
+  cost.linearize(truth_, 0);
+  const double on_object = cost.energy(truth_);
+  ASSERT_GT(on_object, 0.0);
+  cv::Mat empty_gray(camera_.size(), CV_8UC1, cv::Scalar(90));  // nothing to see
+  PoseCostFrame empty = frame_;
+  empty.levels = make_pyramid(empty_gray, camera_, 3);
+  cost.begin_frame(empty);
+  cost.linearize(truth_, 0);
+  EXPECT_LT(cost.energy(truth_), 1e-3 * on_object);
+  // The first frame again (its pyramid rebuilt: new buffers), and the same pyramid twice.
+  PoseCostFrame again = frame_;
+  again.levels = make_pyramid(frame_.levels[0].gray.clone(), camera_, 3);
+  for (int i = 0; i < 2; ++i) {
+    cost.begin_frame(again);
+    cost.linearize(truth_, 0);
+    EXPECT_DOUBLE_EQ(cost.energy(truth_), on_object);
+  }
+}
+
 TEST_F(ContourCostTest, ShiftedEnergiesAreTheEnergiesOfTheShiftedPoses) {
   ContourCost cost(extractor_, 2.0, 1.0);
   cost.begin_frame(frame_);

@@ -93,6 +93,10 @@ class ContourCost : public PoseCost {
   std::unique_ptr<WorkerThreads> workers_;  ///< num_threads threads, the caller's included
   const PoseCostFrame* frame_ = nullptr;
   std::vector<LevelImages> levels_;
+  /// The pyramid levels_ were computed from (headers held, so their buffers are not reused
+  /// while they are the key): a begin_frame() on the same levels with the same regions keeps
+  /// levels_ (the session refines a dozen hypotheses around one place on one frame).
+  std::vector<cv::Mat> levels_source_;
   int level_ = 0;
   std::vector<Segment> segments_;
   std::vector<Eigen::Vector3d> samples_;  ///< object frame, m
