@@ -239,9 +239,28 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
     // overlap with the image rectangle: read from integral images, not correlated.
     cv::Mat padded_posterior;
     cv::copyMakeBorder(posterior, padded_posterior, half, half, half, half, cv::BORDER_CONSTANT, 0);
-    cv::Mat posterior_inside, posterior_ring;
-    cv::matchTemplate(padded_posterior, inside_template, posterior_inside, cv::TM_CCORR);
-    cv::matchTemplate(padded_posterior, ring_template, posterior_ring, cv::TM_CCORR);
+    // The centres searched: every image pixel, or those within the reach (a tracked search
+    // keeps to a fraction of a diameter: correlating the whole frame would cost most of it).
+    cv::Rect centres(0, 0, small.cols, small.rows);
+    if (reach2 > 0.0) {
+      const double x0 = std::floor(reference_px.x() - reach_working);
+      const double y0 = std::floor(reference_px.y() - reach_working);
+      const double x1 = std::ceil(reference_px.x() + reach_working);
+      const double y1 = std::ceil(reference_px.y() + reach_working);
+      if (!(x1 >= 0.0 && y1 >= 0.0 && x0 < small.cols && y0 < small.rows)) continue;
+      const int left = static_cast<int>(std::max(0.0, x0)),
+                top = static_cast<int>(std::max(0.0, y0));
+      centres &=
+          cv::Rect(left, top, static_cast<int>(std::min<double>(small.cols - 1, x1)) - left + 1,
+                   static_cast<int>(std::min<double>(small.rows - 1, y1)) - top + 1);
+      if (centres.empty()) continue;
+    }
+    // Template top-left at padded (c, r) centres it on image pixel (c, r).
+    const cv::Mat window = padded_posterior(
+        cv::Rect(centres.x, centres.y, centres.width + side - 1, centres.height + side - 1));
+    cv::Mat posterior_inside, posterior_ring;  // index (c, r): centre centres.tl() + (c, r)
+    cv::matchTemplate(window, inside_template, posterior_inside, cv::TM_CCORR);
+    cv::matchTemplate(window, ring_template, posterior_ring, cv::TM_CCORR);
     cv::Mat inside_integral, ring_integral;
     cv::integral(mask / 255, inside_integral, CV_32S);
     cv::integral(ring / 255, ring_integral, CV_32S);
@@ -260,19 +279,19 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
       const float* pi = posterior_inside.ptr<float>(r);
       const float* pr = posterior_ring.ptr<float>(r);
       for (int c = 0; c < posterior_inside.cols; ++c) {
-        const float area_inside = in_image(inside_integral, r, c);
-        const float area_ring = in_image(ring_integral, r, c);
+        const int u = centres.x + c, v = centres.y + r;  // image pixel
+        const float area_inside = in_image(inside_integral, v, u);
+        const float area_ring = in_image(ring_integral, v, u);
         if (area_inside < min_area || area_ring < 1.0f) continue;
-        if (reach2 > 0.0 && (Eigen::Vector2d(c, r) - reference_px).squaredNorm() > reach2) continue;
+        if (reach2 > 0.0 && (Eigen::Vector2d(u, v) - reference_px).squaredNorm() > reach2) continue;
         const double contrast = pi[c] / area_inside - pr[c] / area_ring;
         if (contrast > best) {
           best = contrast;
-          best_at = {c, r};
+          best_at = {u, v};
         }
       }
     }
     if (best_at.x < 0) continue;
-    // Result (c, r) = template's top-left at padded (c, r): its centre is image pixel (c, r).
     SearchCandidate candidate;
     candidate.object_to_camera = placed_at(reference, center_object_, working_camera,
                                            Eigen::Vector2d(best_at.x, best_at.y), depth_m);

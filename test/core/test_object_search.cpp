@@ -174,6 +174,35 @@ TEST_F(ObjectSearchTest, AReachKeepsTheSearchNearTheReference) {
     EXPECT_LE((camera_.project(candidate.object_to_camera * c) - reference_px).norm(), 60.0 + 2.0);
 }
 
+TEST_F(ObjectSearchTest, AReachAtTheImageBorderFindsWhatTheWholeFrameFinds) {
+  // The search within a reach correlates only the window the reach covers: at the border, with
+  // the reference's centre outside the image, it must find the placement the whole frame finds.
+  ObjectSearch search(mesh_);
+  const Pose learned_at = test::make_pose(0.4);
+  ASSERT_TRUE(search.learn(frame_at(learned_at), learned_at, camera_));
+  const Eigen::Vector3d c = mesh_->bounding_box_center();
+  const auto centred_at_x = [&](double x_px) {
+    Pose pose = learned_at;
+    const Eigen::Vector3d centre = learned_at * c;
+    pose.translation().x() += (x_px - camera_.cx()) * centre.z() / camera_.fx() - centre.x();
+    return pose;
+  };
+  const cv::Mat frame = frame_at(centred_at_x(20.0));  // a bit over half the box in the image
+  const Pose reference = centred_at_x(-15.0);          // its centre 15 px left of the image
+  const std::vector<SearchCandidate> whole = search.search(frame, reference, camera_);
+  const std::vector<SearchCandidate> near = search.search(frame, reference, camera_, 80.0);
+  ASSERT_FALSE(whole.empty());
+  ASSERT_FALSE(near.empty());
+  const Eigen::Vector2d whole_px = camera_.project(whole.front().object_to_camera * c);
+  const Eigen::Vector2d near_px = camera_.project(near.front().object_to_camera * c);
+  EXPECT_LT((near_px - whole_px).norm(), 1e-6);
+  EXPECT_NEAR(near.front().contrast, whole.front().contrast, 1e-5);
+  EXPECT_NEAR(near.front().visible_fraction, whole.front().visible_fraction, 1e-9);
+  EXPECT_LT(std::abs(near_px.x() - 20.0), 8.0);
+  // A reach that covers no pixel of the image: nothing, and no exception.
+  EXPECT_TRUE(search.search(frame, centred_at_x(-200.0), camera_, 60.0).empty());
+}
+
 TEST_F(ObjectSearchTest, GreyFramesStoredAsColourAreRecognized) {
   const cv::Mat colour = frame_at(test::make_pose(0.4));
   EXPECT_FALSE(ObjectSearch::looks_grey(colour));
