@@ -212,6 +212,41 @@ TEST_F(ObjectSearchTest, GreyFramesStoredAsColourAreRecognized) {
   EXPECT_TRUE(ObjectSearch::looks_grey(grey_bgr));
 }
 
+TEST(SilhouetteRing, IsTheDiscDilationMinusTheMask) {
+  // Against OpenCV's dilation by the same disc: shapes touching the borders, a single pixel,
+  // thin lines and noise, rings of 1 to 25 px.
+  cv::RNG rng(7);
+  for (int trial = 0; trial < 12; ++trial) {
+    cv::Mat mask(37 + 11 * trial, 53 + 7 * trial, CV_8UC1, cv::Scalar(0));
+    cv::ellipse(mask, cv::Point(rng.uniform(0, mask.cols), rng.uniform(0, mask.rows)),
+                cv::Size(rng.uniform(1, 30), rng.uniform(1, 20)), rng.uniform(0.0, 180.0), 0, 360,
+                cv::Scalar(255), cv::FILLED);
+    cv::line(mask, cv::Point(0, rng.uniform(0, mask.rows)),
+             cv::Point(mask.cols - 1, rng.uniform(0, mask.rows)), cv::Scalar(255), 1);
+    mask.at<uchar>(rng.uniform(0, mask.rows), rng.uniform(0, mask.cols)) = 255;
+    if (trial % 3 == 0) {
+      cv::Mat noise(mask.size(), CV_8UC1);
+      rng.fill(noise, cv::RNG::UNIFORM, 0, 100);
+      mask.setTo(255, noise < 2);
+    }
+    for (const int ring_px : {1, 2, 3, 5, 8, 13, 25}) {
+      cv::Mat dilated;
+      cv::dilate(mask, dilated,
+                 cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * ring_px + 1, 2 * ring_px + 1}));
+      const cv::Mat expected = dilated & ~mask;
+      const cv::Mat ring = silhouette_ring(mask, ring_px);
+      ASSERT_EQ(ring.size(), mask.size());
+      ASSERT_EQ(ring.type(), CV_8UC1);
+      EXPECT_EQ(cv::countNonZero(ring != expected), 0) << "trial " << trial << ", ring " << ring_px;
+      EXPECT_GT(cv::countNonZero(ring), 0);
+    }
+  }
+  // Empty mask: empty ring. Bad input: an exception.
+  EXPECT_EQ(cv::countNonZero(silhouette_ring(cv::Mat::zeros(20, 30, CV_8UC1), 4)), 0);
+  EXPECT_THROW(silhouette_ring(cv::Mat::zeros(20, 30, CV_32F), 4), std::invalid_argument);
+  EXPECT_THROW(silhouette_ring(cv::Mat::zeros(20, 30, CV_8UC1), 0), std::invalid_argument);
+}
+
 TEST(ObjectSearchSettings, RejectsBadValues) {
   auto mesh = std::make_shared<Mesh>(test::make_box(0.08, 0.06, 0.05));
   ObjectSearchSettings settings;

@@ -46,6 +46,10 @@ struct SearchCandidate {
   double visible_fraction = 0.0;  ///< share of the silhouette inside the image, [0, 1]
 };
 
+/// The ring of pixels around a silhouette: `mask` (CV_8UC1, 0 or 255) dilated by OpenCV's disc
+/// of radius `ring_px` (cv::MORPH_ELLIPSE, 2 ring_px + 1 wide), minus the mask; 255 on the ring.
+cv::Mat silhouette_ring(const cv::Mat& mask, int ring_px);
+
 /// The object's colour model and the searches that use it.
 class ObjectSearch {
  public:
