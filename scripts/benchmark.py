@@ -825,16 +825,16 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
                                            fmt(weighted_auc(sel(preset=p)))))
     L.append("")
     caps = sorted({min(HARD_TRACK_FRAMES.get(c[1], frames), frames) for c in configs})
+    n = caps[0]
+
+    def first_n(rr):
+        errs = [(e / r["diameter_m"]) for r in rr for e in r["visible_errors"][:n] if e is not None]
+        return auc(errs, 1.0)
     if len(caps) > 1:
-        n = caps[0]
         L.append("Comparable with the presets tracked on fewer frames: every preset on the first %d frames "
                  "of each sequence.\n" % n)
         L.append("| preset | " + " | ".join(conditions) + " | **all** |")
         L.append("|---|" + "---|" * (len(conditions) + 1))
-
-        def first_n(rr):
-            errs = [(e / r["diameter_m"]) for r in rr for e in r["visible_errors"][:n] if e is not None]
-            return auc(errs, 1.0)
         for p in labels:
             L.append("| %s | %s | **%s** |" % (p, " | ".join(fmt(first_n(sel(preset=p, condition=c))) for c in conditions),
                                                fmt(first_n(sel(preset=p)))))
@@ -845,6 +845,14 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
     for p in labels:
         L.append("| %s | %s |" % (p, " | ".join(fmt(weighted_auc(sel(preset=p, object=o))) for o in objects)))
     L.append("")
+    if len(caps) > 1:
+        L.append("Per object on the first %d frames of each sequence (comparable with the presets tracked "
+                 "on fewer frames):\n" % n)
+        L.append("| preset | " + " | ".join(objects) + " |")
+        L.append("|---|" + "---|" * len(objects))
+        for p in labels:
+            L.append("| %s | %s |" % (p, " | ".join(fmt(first_n(sel(preset=p, object=o))) for o in objects)))
+        L.append("")
     L.append("### AUC per object and condition\n")
     L.append("| preset | object | " + " | ".join(conditions) + " |")
     L.append("|---|---|" + "---|" * len(conditions))
