@@ -216,7 +216,8 @@ cv::Mat silhouette_ring(const cv::Mat& mask, int ring_px) {
       }
     if (first < 0) continue;
     if (first + last != 2 * ring_px || cv::countNonZero(element.row(j)) != last - first + 1) {
-      cv::Mat dilated;  // not a centred run (another OpenCV's element): the library's dilation
+      // Not centred runs (another OpenCV version's disc): the library's dilation.
+      cv::Mat dilated;
       cv::dilate(mask, dilated, element);
       return dilated & ~mask;
     }
@@ -244,8 +245,7 @@ cv::Mat silhouette_ring(const cv::Mat& mask, int ring_px) {
       }
     }
   }
-  cv::Mat ring = dilated & ~mask;
-  return ring;
+  return dilated & ~mask;
 }
 
 std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose& reference,
