@@ -178,20 +178,17 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     std::vector<SearchCandidate> found = search_->search(bgr, last_good, camera, reach_px);
     if (static_cast<int>(found.size()) > params_.color_search_placements)
       found.resize(static_cast<std::size_t>(params_.color_search_placements));
+    // found: best contrast first.
     if (std::isfinite(bar.min_contrast)) {
-      const auto best_placed = std::max_element(
-          found.begin(), found.end(), [](const SearchCandidate& a, const SearchCandidate& b) {
-            return a.contrast < b.contrast;
-          });
       const double level = monitor_.color_level();
-      if (best_placed == found.end() ||
-          best_placed->contrast < bar.min_contrast - kTrackedSearchRefineSlack * level) {
+      if (found.empty() ||
+          found.front().contrast < bar.min_contrast - kTrackedSearchRefineSlack * level) {
         // As a refined search would: the best placement confirms the next frame's (while lost)
         // when it is at least color_confirm_ratio x the level.
         unconfirmed_.reset();
-        if (best_placed != found.end() && params_.color_confirm_ratio > 0.0 &&
-            best_placed->contrast >= params_.color_confirm_ratio * level)
-          unconfirmed_ = best_placed->object_to_camera;
+        if (!found.empty() && params_.color_confirm_ratio > 0.0 &&
+            found.front().contrast >= params_.color_confirm_ratio * level)
+          unconfirmed_ = found.front().object_to_camera;
         return TrackResult();
       }
     }
@@ -395,10 +392,8 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   const double held_correlation = held_agreement.correlation;
   if (held_agreement.points >= SurfaceTexture::kMinPoints) result.texture_correlation = held_correlation;
   if (held_agreement.points >= SurfaceTexture::kMinPoints &&
-      shift_by_texture(frame, bgr, prepared, held_correlation, result))
-    return;
-  if (held_agreement.points >= SurfaceTexture::kMinPoints &&
-      align_by_texture(frame, bgr, prepared, held_correlation, result))
+      (shift_by_texture(frame, bgr, prepared, held_correlation, result) ||
+       align_by_texture(frame, bgr, prepared, held_correlation, result)))
     return;
   if (!turns_due) return;
   // Turns about the object's own axes through its centre, k x step for k = 1 .. n - 1.
