@@ -196,9 +196,12 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     const Eigen::Vector3d& center_object = tracker_->center_object();
     // The pose the last frame ended at (a placement taken while lost, or where the pipeline
     // went): the object moves on between frames, so last frame's find is this frame's best start.
-    if (((tracker_->last_pose() * center_object) - (last_good * center_object)).norm() >
-        0.05 * tracker_->diameter_m())
-      hypotheses.push_back(tracker_->last_pose());
+    // Not when it went behind the camera (a long extrapolation): it cannot be refined.
+    const Pose& last = tracker_->last_pose();
+    if (is_valid_pose(last) && last.translation().z() > 0.0 &&
+        ((last * center_object) - (last_good * center_object)).norm() >
+            0.05 * tracker_->diameter_m())
+      hypotheses.push_back(last);
     const double angle = params_.color_search_rotation_deg * M_PI / 180.0;
     for (const SearchCandidate& candidate : found) {
       const Pose& placed = candidate.object_to_camera;
