@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstring>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "klt_contour_tracker/core/check_range.h"
+#include "klt_contour_tracker/core/worker_threads.h"
 
 namespace kct {
 namespace {
@@ -39,6 +41,7 @@ void ObjectSearchSettings::validate() const {
   for (double s : depth_scales) check_range(kOwner, "depth_scales[i]", s, 0.05, 20.0);
   check_range(kOwner, "min_visible_fraction", min_visible_fraction, 1e-3, 1.0);
   check_range(kOwner, "ring_fraction", ring_fraction, 0.01, 2.0);
+  check_range(kOwner, "threads", threads, 1, 64);
 }
 
 ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchSettings& settings)
@@ -48,6 +51,16 @@ ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchS
   diameter_m_ = mesh_->diameter();
   center_object_ = mesh_->bounding_box_center();
   box_object_ = mesh_->bounding_box();
+  workers_ = std::make_unique<WorkerThreads>(settings_.threads);
+}
+
+ObjectSearch::~ObjectSearch() = default;
+
+void ObjectSearch::set_threads(int threads) {
+  check_range(kOwner, "threads", threads, 1, 64);
+  if (threads == settings_.threads) return;
+  settings_.threads = threads;
+  workers_ = std::make_unique<WorkerThreads>(threads);
 }
 
 bool ObjectSearch::looks_grey(const cv::Mat& bgr) {
@@ -161,36 +174,37 @@ std::vector<SearchCandidate> ObjectSearch::score(const cv::Mat& bgr,
   // The working image and its posterior are the same for every pose.
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
-  cv::Mat posterior;  // computed when the first pose needs it
+  const cv::Mat posterior = posterior_map(small);
   RenderOptions options;
   options.draw_color = false;
-  for (SearchCandidate& result : results) {
-    if (!(result.object_to_camera.translation().z() > 0)) continue;
+  // Each pose writes only its own result.
+  workers_->parallel_for(static_cast<int>(results.size()), [&](int i) {
+    SearchCandidate& result = results[static_cast<std::size_t>(i)];
+    if (!(result.object_to_camera.translation().z() > 0)) return;
     // Rendered on a canvas around the silhouette and its ring, not only the image: the share
     // outside the image is the visible fraction's denominator.
     const cv::Rect canvas_rect = silhouette_canvas(result.object_to_camera, working_camera);
-    if (canvas_rect.empty()) continue;
+    if (canvas_rect.empty()) return;
     const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(),
                                       working_camera.cx() - canvas_rect.x,
                                       working_camera.cy() - canvas_rect.y, canvas_rect.width,
                                       canvas_rect.height);
     const cv::Mat canvas = renderer_.render(result.object_to_camera, canvas_camera, options).mask();
     const double total = cv::countNonZero(canvas);
-    if (total <= 0) continue;
+    if (total <= 0) return;
     // The image's part of the canvas, in canvas pixels.
     const cv::Rect image_rect =
         (cv::Rect(0, 0, small.cols, small.rows) & canvas_rect) - canvas_rect.tl();
-    if (image_rect.empty()) continue;
+    if (image_rect.empty()) return;
     const cv::Mat mask = canvas(image_rect);
     result.visible_fraction = cv::countNonZero(mask) / total;
-    if (result.visible_fraction < settings_.min_visible_fraction) continue;
+    if (result.visible_fraction < settings_.min_visible_fraction) return;
     const cv::Mat ring =
         silhouette_ring(canvas, ring_width_px(canvas, settings_.ring_fraction))(image_rect);
-    if (cv::countNonZero(ring) == 0) continue;
-    if (posterior.empty()) posterior = posterior_map(small);
+    if (cv::countNonZero(ring) == 0) return;
     const cv::Mat posterior_visible = posterior(image_rect + canvas_rect.tl());
     result.contrast = cv::mean(posterior_visible, mask)[0] - cv::mean(posterior_visible, ring)[0];
-  }
+  });
   return results;
 }
 
@@ -263,21 +277,25 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
   const double reach2 = reach_px > 0.0 ? reach_working * reach_working : 0.0;
   RenderOptions options;
   options.draw_color = false;
-  for (double scale : settings_.depth_scales) {
+  // One candidate per depth, each depth on its own (the order kept: a tie sorts the same way
+  // whatever the thread count).
+  std::vector<std::optional<SearchCandidate>> per_depth(settings_.depth_scales.size());
+  workers_->parallel_for(static_cast<int>(per_depth.size()), [&](int d) {
+    const double scale = settings_.depth_scales[static_cast<std::size_t>(d)];
     const double depth_m = reference_depth * scale;
     // The silhouette on a square canvas with the object's centre at the canvas centre.
     const double radius_px = working_camera.fx() * 0.5 * diameter_m_ / depth_m;
     const int ring_guess = std::max(2, static_cast<int>(std::ceil(settings_.ring_fraction * 2.0 * radius_px)));
     const int half = static_cast<int>(std::ceil(radius_px)) + ring_guess + 2;
     const int side = 2 * half + 1;
-    if (side > 4 * std::max(small.cols, small.rows) || side < 5) continue;
+    if (side > 4 * std::max(small.cols, small.rows) || side < 5) return;
     const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(), half, half, side,
                                       side);
     const Pose centred = placed_at(reference, center_object_, canvas_camera,
                                    Eigen::Vector2d(half, half), depth_m);
     const cv::Mat mask = renderer_.render(centred, canvas_camera, options).mask();
     const double area = cv::countNonZero(mask);
-    if (area < 4) continue;
+    if (area < 4) return;
     const cv::Mat ring = silhouette_ring(mask, ring_width_px(mask, settings_.ring_fraction));
     cv::Mat inside_template, ring_template;
     mask.convertTo(inside_template, CV_32F, 1.0 / 255.0);
@@ -295,13 +313,13 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
       const double y0 = std::floor(reference_px.y() - reach_working);
       const double x1 = std::ceil(reference_px.x() + reach_working);
       const double y1 = std::ceil(reference_px.y() + reach_working);
-      if (!(x1 >= 0.0 && y1 >= 0.0 && x0 < small.cols && y0 < small.rows)) continue;
+      if (!(x1 >= 0.0 && y1 >= 0.0 && x0 < small.cols && y0 < small.rows)) return;
       const int left = static_cast<int>(std::max(0.0, x0)),
                 top = static_cast<int>(std::max(0.0, y0));
       centres &=
           cv::Rect(left, top, static_cast<int>(std::min<double>(small.cols - 1, x1)) - left + 1,
                    static_cast<int>(std::min<double>(small.rows - 1, y1)) - top + 1);
-      if (centres.empty()) continue;
+      if (centres.empty()) return;
     }
     // Template top-left at padded (c, r) centres it on image pixel (c, r).
     const cv::Mat window = padded_posterior(
@@ -339,15 +357,17 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
         }
       }
     }
-    if (best_at.x < 0) continue;
+    if (best_at.x < 0) return;
     SearchCandidate candidate;
     candidate.object_to_camera = placed_at(reference, center_object_, working_camera,
                                            Eigen::Vector2d(best_at.x, best_at.y), depth_m);
     candidate.contrast = best;
     candidate.visible_fraction =
         std::min(1.0, in_image(inside_integral, best_at.y, best_at.x) / area);
-    candidates.push_back(candidate);
-  }
+    per_depth[static_cast<std::size_t>(d)] = candidate;
+  });
+  for (const auto& candidate : per_depth)
+    if (candidate) candidates.push_back(*candidate);
   std::sort(candidates.begin(), candidates.end(),
             [](const SearchCandidate& a, const SearchCandidate& b) { return a.contrast > b.contrast; });
   return candidates;

@@ -105,10 +105,16 @@ void TrackingSession::set_camera(const PinholeCamera& camera) {
     tracker_ = std::make_unique<Tracker>(mesh_, camera, params_);
   else
     tracker_->set_camera(camera);
-  if (params_.color_search && !search_) search_ = std::make_unique<ObjectSearch>(mesh_);
+  if (params_.color_search && !search_) search_ = make_search();
   if (params_.feature_relocalization && !relocalizer_)
     relocalizer_ = std::make_unique<FeatureRelocalizer>(mesh_);
   if (params_.texture_check_margin > 0.0 && !texture_) texture_ = std::make_unique<SurfaceTexture>(mesh_);
+}
+
+std::unique_ptr<ObjectSearch> TrackingSession::make_search() const {
+  ObjectSearchSettings settings;
+  settings.threads = params_.num_threads;
+  return std::make_unique<ObjectSearch>(mesh_, settings);
 }
 
 const Tracker& TrackingSession::tracker() const {
@@ -152,7 +158,9 @@ void TrackingSession::set_params(const TrackerParams& params) {
   if (!params_.color_search)
     search_.reset();
   else if (!search_ && tracker_)
-    search_ = std::make_unique<ObjectSearch>(mesh_);
+    search_ = make_search();
+  else if (search_)
+    search_->set_threads(params_.num_threads);
   if (!(params_.texture_check_margin > 0.0))
     texture_.reset();
   else if (!texture_ && tracker_)

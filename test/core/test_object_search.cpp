@@ -125,6 +125,43 @@ TEST_F(ObjectSearchTest, FindsTheObjectFarFromTheReferencePose) {
   EXPECT_TRUE(found.front().object_to_camera.linear().isApprox(learned_at.linear(), 1e-12));
 }
 
+TEST_F(ObjectSearchTest, ResultsDoNotDependOnTheThreadCount) {
+  ObjectSearchSettings two_threads;
+  two_threads.threads = 2;
+  ObjectSearch one(mesh_), two(mesh_, two_threads);
+  const Pose learned_at = test::make_pose(0.4);
+  ASSERT_TRUE(one.learn(frame_at(learned_at), learned_at, camera_));
+  ASSERT_TRUE(two.learn(frame_at(learned_at), learned_at, camera_));
+  const Pose shown_at =
+      test::move(learned_at, 10, Eigen::Vector3d(0.3, 1.0, 0.2), {0.12, 0.06, 0.08});
+  const cv::Mat frame = frame_at(shown_at);
+  const std::vector<SearchCandidate> found_one = one.search(frame, learned_at, camera_);
+  const std::vector<SearchCandidate> found_two = two.search(frame, learned_at, camera_);
+  ASSERT_EQ(found_one.size(), one.settings().depth_scales.size());  // every depth places it
+  ASSERT_EQ(found_two.size(), found_one.size());
+  std::vector<Pose> poses{shown_at, learned_at};
+  for (std::size_t i = 0; i < found_one.size(); ++i) {
+    EXPECT_EQ(found_two[i].contrast, found_one[i].contrast);
+    EXPECT_EQ(found_two[i].visible_fraction, found_one[i].visible_fraction);
+    EXPECT_TRUE(found_two[i].object_to_camera.isApprox(found_one[i].object_to_camera, 0.0));
+    poses.push_back(found_one[i].object_to_camera);
+  }
+  const std::vector<SearchCandidate> scored_one = one.score(frame, poses, camera_);
+  const std::vector<SearchCandidate> scored_two = two.score(frame, poses, camera_);
+  ASSERT_EQ(scored_two.size(), poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    EXPECT_EQ(scored_two[i].contrast, scored_one[i].contrast);
+    EXPECT_EQ(scored_two[i].visible_fraction, scored_one[i].visible_fraction);
+    EXPECT_TRUE(scored_two[i].object_to_camera.isApprox(poses[i], 0.0));
+  }
+  EXPECT_GT(scored_two[0].contrast, 0.8);  // at the object
+  // Changing the thread count keeps the learned colours.
+  two.set_threads(1);
+  EXPECT_EQ(two.settings().threads, 1);
+  EXPECT_EQ(two.score(frame, shown_at, camera_).contrast, scored_one[0].contrast);
+  EXPECT_THROW(two.set_threads(0), std::invalid_argument);
+}
+
 TEST_F(ObjectSearchTest, FindsAnObjectEnteringTheImage) {
   ObjectSearch search(mesh_);
   const Pose learned_at = test::make_pose(0.4);
@@ -257,6 +294,9 @@ TEST(ObjectSearchSettings, RejectsBadValues) {
   EXPECT_THROW(ObjectSearch(mesh, settings), std::invalid_argument);
   settings = {};
   settings.learning_rate = 2.0;
+  EXPECT_THROW(ObjectSearch(mesh, settings), std::invalid_argument);
+  settings = {};
+  settings.threads = 0;
   EXPECT_THROW(ObjectSearch(mesh, settings), std::invalid_argument);
   EXPECT_THROW(ObjectSearch(nullptr), std::invalid_argument);
 }

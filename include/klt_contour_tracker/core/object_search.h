@@ -23,6 +23,8 @@
 
 namespace kct {
 
+class WorkerThreads;
+
 /// Settings of the colour search (all ours).
 struct ObjectSearchSettings {
   int working_width_px = 320;    ///< frames are halved until at most this wide, px
@@ -34,6 +36,9 @@ struct ObjectSearchSettings {
   double min_visible_fraction = 0.3;
   /// Width of the ring around the silhouette, as a fraction of its larger side (at least 2 px).
   double ring_fraction = 0.15;
+  /// Threads in all, the caller's included, for the depths of a search and the poses of a
+  /// score (results do not depend on it), [1, 64].
+  int threads = 1;
 
   /// Throws std::invalid_argument naming the first bad field and its allowed range.
   void validate() const;
@@ -55,6 +60,13 @@ class ObjectSearch {
  public:
   /// Throws std::invalid_argument for an empty mesh or invalid settings.
   ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchSettings& settings = {});
+  ~ObjectSearch();
+  ObjectSearch(const ObjectSearch&) = delete;
+  ObjectSearch& operator=(const ObjectSearch&) = delete;
+
+  /// Changes settings().threads (the learned colours are kept). Throws std::invalid_argument
+  /// outside [1, 64].
+  void set_threads(int threads);
 
   /// Learns the colours from `bgr` (CV_8UC3, undistorted, the camera's size) at a trusted pose.
   /// Returns false (nothing learned) when the silhouette is too small or mostly outside.
@@ -106,6 +118,7 @@ class ObjectSearch {
   double diameter_m_ = 0.0;
   Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();
   Eigen::AlignedBox3d box_object_;  ///< the mesh's bounding box
+  std::unique_ptr<WorkerThreads> workers_;  ///< settings_.threads threads
 };
 
 }  // namespace kct

@@ -125,6 +125,8 @@ class TrackingSession {
   void clear_statistics() { statistics_ = {}; }
 
  private:
+  /// The colour model, its searches on params_.num_threads threads.
+  std::unique_ptr<ObjectSearch> make_search() const;
   /// Re-acquisition while lost: the colour search's hypotheses, else (not `color_only`) a
   /// refinement around the last good pose. `color_only` and nothing found (or nothing above
   /// `bar`): a default result (searched false).
