@@ -41,10 +41,7 @@ struct Cell {
   int x0, y0;
   double ax, ay;
 };
-bool cell_of(const Eigen::Vector3d& x, const Projection& project, const cv::Rect& roi, Cell* cell) {
-  if (x.z() <= kMinDepth) return false;
-  const Eigen::Vector2d p = project(x);
-  const double u = p.x(), v = p.y();
+bool cell_at(double u, double v, const cv::Rect& roi, Cell* cell) {
   if (!(u >= roi.x + 1.0 && v >= roi.y + 1.0 && u <= roi.x + roi.width - 2.0 &&
         v <= roi.y + roi.height - 2.0))
     return false;
@@ -54,6 +51,27 @@ bool cell_of(const Eigen::Vector3d& x, const Projection& project, const cv::Rect
   cell->ax = lu - cell->x0;
   cell->ay = lv - cell->y0;
   return true;
+}
+bool cell_of(const Eigen::Vector3d& x, const Projection& project, const cv::Rect& roi, Cell* cell) {
+  if (x.z() <= kMinDepth) return false;
+  const Eigen::Vector2d p = project(x);
+  return cell_at(p.x(), p.y(), roi, cell);
+}
+
+/// A camera-frame point's projection and inverse depth (shifted_energies()); `in_front` false
+/// when it is behind the camera (then nothing else is set).
+struct Projected {
+  double u = 0.0, v = 0.0, inv_z = 0.0;
+  bool in_front = false;
+};
+Projected projected(const Eigen::Vector3d& x, const Projection& project) {
+  Projected p;
+  if (x.z() <= kMinDepth) return p;
+  p.in_front = true;
+  p.inv_z = 1.0 / x.z();
+  p.u = project.fx * x.x() * p.inv_z + project.cx;
+  p.v = project.fy * x.y() * p.inv_z + project.cy;
+  return p;
 }
 
 }  // namespace
@@ -289,33 +307,46 @@ double ContourCost::energy(const Pose& object_to_camera, int* num_points) const 
 std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
                                                   const std::vector<Eigen::Vector3d>& shifts_camera,
                                                   std::vector<int>* num_points) const {
+  for (const Eigen::Vector3d& shift : shifts_camera)
+    if (shift.z() != 0.0)
+      throw std::invalid_argument(
+          "ContourCost::shifted_energies: shifts must be parallel to the image plane (z = 0)");
   std::vector<double> energies(shifts_camera.size(), 0.0);
   if (num_points) num_points->assign(shifts_camera.size(), 0);
   if (!frame_ || levels_.empty() || levels_[level_].roi.empty()) return energies;
-  // accumulate() without derivatives, on points moved to the camera frame once.
+  // accumulate() without derivatives. A shift parallel to the image plane keeps every point's
+  // depth, so its projection moves by (fx sx, fy sy) / z: the points are projected once for all
+  // shifts, and each shift costs a multiply-add per coordinate (not a division).
   const LevelImages& images = levels_[level_];
   const PinholeCamera& camera = frame_->levels[level_].camera;
   const Projection project{camera.fx(), camera.fy(), camera.cx(), camera.cy()};
-  std::vector<Eigen::Vector3d> ends_camera(2 * segments_.size()), samples_camera(samples_.size());
+  std::vector<Projected> ends(2 * segments_.size()), samples(samples_.size());
   for (std::size_t i = 0; i < segments_.size(); ++i) {
-    ends_camera[2 * i] = object_to_camera * segments_[i].a_object;
-    ends_camera[2 * i + 1] = object_to_camera * segments_[i].b_object;
+    ends[2 * i] = projected(object_to_camera * segments_[i].a_object, project);
+    ends[2 * i + 1] = projected(object_to_camera * segments_[i].b_object, project);
   }
-  for (std::size_t k = 0; k < samples_.size(); ++k) samples_camera[k] = object_to_camera * samples_[k];
+  for (std::size_t k = 0; k < samples_.size(); ++k)
+    samples[k] = projected(object_to_camera * samples_[k], project);
   for (std::size_t s = 0; s < shifts_camera.size(); ++s) {
-    const Eigen::Vector3d& shift = shifts_camera[s];
+    const double du = project.fx * shifts_camera[s].x(), dv = project.fy * shifts_camera[s].y();
     double sum = 0.0;
     int kept = 0;
     for (std::size_t i = 0; i < segments_.size(); ++i) {
+      const Projected& a = ends[2 * i];
+      const Projected& b = ends[2 * i + 1];
+      if (!a.in_front || !b.in_front) continue;
+      // As project_segment() on the shifted ends.
+      const Eigen::Vector2d d(b.u - a.u + du * (b.inv_z - a.inv_z),
+                              b.v - a.v + dv * (b.inv_z - a.inv_z));
+      const double length = d.norm();
+      if (!(length > 1e-9) || !std::isfinite(length)) continue;
+      const Eigen::Vector2d normal = Eigen::Vector2d(-d.y(), d.x()) / length;
       const Segment& segment = segments_[i];
-      Eigen::Vector2d normal;
-      double length = 0.0;
-      if (!project_segment(ends_camera[2 * i] + shift, ends_camera[2 * i + 1] + shift, project,
-                           &length, &normal))
-        continue;
       for (int k = segment.first_sample; k < segment.end_sample; ++k) {
+        const Projected& q = samples[static_cast<std::size_t>(k)];
         Cell c;
-        if (!cell_of(samples_camera[k] + shift, project, images.roi, &c)) continue;
+        if (!q.in_front || !cell_at(q.u + du * q.inv_z, q.v + dv * q.inv_z, images.roi, &c))
+          continue;
         sum += std::abs(bilinear(images.gx, c.x0, c.y0, c.ax, c.ay) * normal.x() +
                         bilinear(images.gy, c.x0, c.y0, c.ax, c.ay) * normal.y());
         ++kept;

@@ -203,6 +203,8 @@ TEST_F(ContourCostTest, ShiftedEnergiesAreTheEnergiesOfTheShiftedPoses) {
   EXPECT_EQ(counts[4], 0);  // 2 m aside: outside the image
   // The shift back to the truth scores higher than staying.
   EXPECT_GT(energies[1], energies[0]);
+  // Only shifts parallel to the image plane.
+  EXPECT_THROW(cost.shifted_energies(pose, {{0.0, 0.0, 0.01}}, &counts), std::invalid_argument);
 }
 
 TEST_F(ContourCostTest, ResultDoesNotDependOnTheThreadCount) {

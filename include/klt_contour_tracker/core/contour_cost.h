@@ -58,9 +58,9 @@ class ContourCost : public PoseCost {
   /// last linearize(), and the number of points kept; for tests and diagnostics.
   double energy(const Pose& object_to_camera, int* num_points = nullptr) const;
   /// energy() at `object_to_camera` moved by each of `shifts_camera` (camera-frame
-  /// translations), with each shift's number of points in `num_points` (resized): the fixed
-  /// points are transformed to the camera frame once for all shifts (the refiner's shift search
-  /// scores up to ~1300 shifts of one pose).
+  /// translations parallel to the image plane: z = 0, else std::invalid_argument), with each
+  /// shift's number of points in `num_points` (resized): the fixed points are projected once for
+  /// all shifts (the refiner's shift search scores up to ~1300 shifts of one pose).
   std::vector<double> shifted_energies(const Pose& object_to_camera,
                                        const std::vector<Eigen::Vector3d>& shifts_camera,
                                        std::vector<int>* num_points) const;
