@@ -125,9 +125,7 @@ bool ObjectSearch::learn(const cv::Mat& bgr, const Pose& object_to_camera,
                          const PinholeCamera& camera) {
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
-  RenderOptions options;
-  options.draw_color = false;
-  const cv::Mat mask = renderer_.render(object_to_camera, working_camera, options).mask();
+  const cv::Mat mask = renderer_.render_silhouette(object_to_camera, working_camera);
   return histograms_.learn(small, mask, settings_.band_px, settings_.learning_rate);
 }
 
@@ -175,8 +173,6 @@ std::vector<SearchCandidate> ObjectSearch::score(const cv::Mat& bgr,
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
   const cv::Mat posterior = posterior_map(small);
-  RenderOptions options;
-  options.draw_color = false;
   // Each pose writes only its own result.
   workers_->parallel_for(static_cast<int>(results.size()), [&](int i) {
     SearchCandidate& result = results[static_cast<std::size_t>(i)];
@@ -189,7 +185,7 @@ std::vector<SearchCandidate> ObjectSearch::score(const cv::Mat& bgr,
                                       working_camera.cx() - canvas_rect.x,
                                       working_camera.cy() - canvas_rect.y, canvas_rect.width,
                                       canvas_rect.height);
-    const cv::Mat canvas = renderer_.render(result.object_to_camera, canvas_camera, options).mask();
+    const cv::Mat canvas = renderer_.render_silhouette(result.object_to_camera, canvas_camera);
     const double total = cv::countNonZero(canvas);
     if (total <= 0) return;
     // The image's part of the canvas, in canvas pixels.
@@ -275,8 +271,6 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
   const Eigen::Vector2d reference_px = working_camera.project(reference * center_object_);
   const double reach_working = reach_px * working_camera.fx() / camera.fx();
   const double reach2 = reach_px > 0.0 ? reach_working * reach_working : 0.0;
-  RenderOptions options;
-  options.draw_color = false;
   // One candidate per depth, each depth on its own (the order kept: a tie sorts the same way
   // whatever the thread count).
   std::vector<std::optional<SearchCandidate>> per_depth(settings_.depth_scales.size());
@@ -293,7 +287,7 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
                                       side);
     const Pose centred = placed_at(reference, center_object_, canvas_camera,
                                    Eigen::Vector2d(half, half), depth_m);
-    const cv::Mat mask = renderer_.render(centred, canvas_camera, options).mask();
+    const cv::Mat mask = renderer_.render_silhouette(centred, canvas_camera);
     const double area = cv::countNonZero(mask);
     if (area < 4) return;
     const cv::Mat ring = silhouette_ring(mask, ring_width_px(mask, settings_.ring_fraction));

@@ -65,9 +65,7 @@ bool RegionCost::learn(const cv::Mat& bgr, const Pose& object_to_camera,
 }
 
 cv::Mat RegionCost::silhouette(const Pose& object_to_camera, const PinholeCamera& camera) const {
-  RenderOptions options;
-  options.draw_color = false;
-  return renderer_.render(object_to_camera, camera, options).mask();
+  return renderer_.render_silhouette(object_to_camera, camera);
 }
 
 bool RegionCost::learn(const cv::Mat& bgr, const cv::Mat& mask) {

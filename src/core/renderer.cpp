@@ -34,6 +34,9 @@ struct Buffers {
   cv::Mat key;         ///< CV_32F depth key, larger = closer
   cv::Mat face_index;  ///< CV_32S
   cv::Mat uv;          ///< CV_32FC2 interpolated texture coordinates (optional)
+  /// CV_8U; when set, only the covered pixels are marked (255) and key, face_index and uv are
+  /// not used: no depth test, and a pixel already covered is not tested again.
+  cv::Mat silhouette;
 };
 
 /// Edge function of a -> b evaluated at p (twice the signed area of a, b, p).
@@ -65,7 +68,9 @@ void rasterize(ScreenVertex v0, ScreenVertex v1, ScreenVertex v2, int face, Buff
     std::swap(v1, v2);
     area = -area;
   }
-  const int width = buffers.key.cols, height = buffers.key.rows;
+  const bool silhouette_only = !buffers.silhouette.empty();
+  const cv::Size size = silhouette_only ? buffers.silhouette.size() : buffers.key.size();
+  const int width = size.width, height = size.height;
   const int x_min = std::max(0, static_cast<int>(std::ceil(std::min({v0.x, v1.x, v2.x}))));
   const int x_max =
       std::min(width - 1, static_cast<int>(std::floor(std::max({v0.x, v1.x, v2.x}))));
@@ -78,6 +83,22 @@ void rasterize(ScreenVertex v0, ScreenVertex v1, ScreenVertex v2, int face, Buff
   const double inv_area = 1.0 / area;
   const bool write_uv = !buffers.uv.empty();
 
+  if (silhouette_only) {
+    // The same coverage test as below (a covered pixel's depth key is always > 0 in front of
+    // the near plane), so the mask is the z-buffered render's.
+    for (int y = y_min; y <= y_max; ++y) {
+      uchar* row = buffers.silhouette.ptr<uchar>(y);
+      for (int x = x_min; x <= x_max; ++x) {
+        if (row[x]) continue;
+        const double e0 = shared_edge(v1, v2, x, y), e1 = shared_edge(v2, v0, x, y),
+                     e2 = shared_edge(v0, v1, x, y);
+        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) continue;
+        if ((e0 == 0.0 && !tl0) || (e1 == 0.0 && !tl1) || (e2 == 0.0 && !tl2)) continue;
+        row[x] = 255;
+      }
+    }
+    return;
+  }
   for (int y = y_min; y <= y_max; ++y) {
     float* key_row = buffers.key.ptr<float>(y);
     int* face_row = buffers.face_index.ptr<int>(y);
@@ -137,6 +158,44 @@ cv::Vec3f sample_texture(const cv::Mat& texture, float u, float v) {
     out[c] = (1 - ay) * ((1 - ax) * r0[x0][c] + ax * r0[x1][c]) +
              ay * ((1 - ax) * r1[x0][c] + ax * r1[x1][c]);
   return out;
+}
+
+/// Transforms the mesh to the camera frame (`points`), clips its faces at the near plane and
+/// rasterizes them into `buffers` (both sides; `textured`: with the corners' UVs).
+void draw_faces(const Mesh& mesh, const Pose& object_to_camera, const PinholeCamera& camera,
+                bool textured, Buffers& buffers, std::vector<Eigen::Vector3d>& points) {
+  points.resize(mesh.vertices.size());
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = object_to_camera * mesh.vertices[i];
+
+  auto to_screen = [&](const Eigen::Vector3d& p, const Eigen::Vector2d& uv) {
+    const double inv_z = 1.0 / p.z();
+    return ScreenVertex{camera.fx() * p.x() * inv_z + camera.cx(),
+                        camera.fy() * p.y() * inv_z + camera.cy(), inv_z, uv.x() * inv_z,
+                        uv.y() * inv_z};
+  };
+
+  for (int f = 0; f < static_cast<int>(mesh.faces.size()); ++f) {
+    const Eigen::Vector3i& face = mesh.faces[f];
+    ClipVertex corners[3];
+    bool all_in_front = true, all_behind = true;
+    for (int k = 0; k < 3; ++k) {
+      corners[k].p = points[face[k]];
+      corners[k].uv = textured ? mesh.corner_uvs[3 * f + k].cast<double>() : Eigen::Vector2d(0, 0);
+      all_in_front = all_in_front && corners[k].p.z() > kNearPlane;
+      all_behind = all_behind && corners[k].p.z() <= kNearPlane;
+    }
+    if (all_behind) continue;
+    if (all_in_front) {
+      rasterize(to_screen(corners[0].p, corners[0].uv), to_screen(corners[1].p, corners[1].uv),
+                to_screen(corners[2].p, corners[2].uv), f, buffers);
+      continue;
+    }
+    ClipVertex polygon[4];
+    const int count = clip_near(corners, polygon);
+    for (int k = 1; k + 1 < count; ++k)
+      rasterize(to_screen(polygon[0].p, polygon[0].uv), to_screen(polygon[k].p, polygon[k].uv),
+                to_screen(polygon[k + 1].p, polygon[k + 1].uv), f, buffers);
+  }
 }
 
 }  // namespace
@@ -222,6 +281,15 @@ Renderer::Renderer(std::shared_ptr<const Mesh> mesh) : mesh_(std::move(mesh)) {
   if (!mesh_) throw std::invalid_argument("Renderer: mesh must not be null");
 }
 
+cv::Mat Renderer::render_silhouette(const Pose& object_to_camera,
+                                    const PinholeCamera& camera) const {
+  Buffers buffers;
+  buffers.silhouette = cv::Mat(camera.height(), camera.width(), CV_8UC1, cv::Scalar(0));
+  std::vector<Eigen::Vector3d> points;
+  draw_faces(*mesh_, object_to_camera, camera, false, buffers, points);
+  return buffers.silhouette;
+}
+
 RenderOutput Renderer::render(const Pose& object_to_camera, const PinholeCamera& camera,
                               const RenderOptions& options) const {
   const Mesh& mesh = *mesh_;
@@ -233,38 +301,8 @@ RenderOutput Renderer::render(const Pose& object_to_camera, const PinholeCamera&
   buffers.face_index = cv::Mat(height, width, CV_32S, cv::Scalar(-1));
   if (textured) buffers.uv = cv::Mat(height, width, CV_32FC2, cv::Scalar(0.0f, 0.0f));
 
-  std::vector<Eigen::Vector3d> points(mesh.vertices.size());
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = object_to_camera * mesh.vertices[i];
-
-  auto to_screen = [&](const Eigen::Vector3d& p, const Eigen::Vector2d& uv) {
-    const double inv_z = 1.0 / p.z();
-    return ScreenVertex{camera.fx() * p.x() * inv_z + camera.cx(),
-                        camera.fy() * p.y() * inv_z + camera.cy(), inv_z, uv.x() * inv_z,
-                        uv.y() * inv_z};
-  };
-
-  for (int f = 0; f < static_cast<int>(mesh.faces.size()); ++f) {
-    const Eigen::Vector3i& face = mesh.faces[f];
-    ClipVertex corners[3];
-    bool all_in_front = true, all_behind = true;
-    for (int k = 0; k < 3; ++k) {
-      corners[k].p = points[face[k]];
-      corners[k].uv = textured ? mesh.corner_uvs[3 * f + k].cast<double>() : Eigen::Vector2d(0, 0);
-      all_in_front = all_in_front && corners[k].p.z() > kNearPlane;
-      all_behind = all_behind && corners[k].p.z() <= kNearPlane;
-    }
-    if (all_behind) continue;
-    if (all_in_front) {
-      rasterize(to_screen(corners[0].p, corners[0].uv), to_screen(corners[1].p, corners[1].uv),
-                to_screen(corners[2].p, corners[2].uv), f, buffers);
-      continue;
-    }
-    ClipVertex polygon[4];
-    const int count = clip_near(corners, polygon);
-    for (int k = 1; k + 1 < count; ++k)
-      rasterize(to_screen(polygon[0].p, polygon[0].uv), to_screen(polygon[k].p, polygon[k].uv),
-                to_screen(polygon[k + 1].p, polygon[k + 1].uv), f, buffers);
-  }
+  std::vector<Eigen::Vector3d> points;
+  draw_faces(mesh, object_to_camera, camera, textured, buffers, points);
 
   RenderOutput out;
   out.face_index = buffers.face_index;

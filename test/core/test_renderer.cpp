@@ -290,3 +290,40 @@ TEST(Renderer, SmoothShadingVariesAcrossAFaceFlatDoesNot) {
   EXPECT_LE(flat_max - flat_min, 1.0);
   EXPECT_GT(smooth_max - smooth_min, 10.0);
 }
+
+TEST(Renderer, SilhouetteIsTheDepthTestedRendersMask) {
+  // Two overlapping boxes (faces drawn over each other), a cube and an open mesh (the cube
+  // without its front face); poses whole in view, partly outside, and crossing the camera
+  // plane (near-plane clipping).
+  auto overlapping = std::make_shared<kct::Mesh>(kct::test::make_box(0.08, 0.05, 0.04, false));
+  const kct::Mesh second = kct::test::make_box(0.03, 0.09, 0.06, false);
+  const int offset = static_cast<int>(overlapping->vertices.size());
+  for (const Eigen::Vector3d& v : second.vertices)
+    overlapping->vertices.push_back(v + Eigen::Vector3d(0.02, 0.01, -0.01));
+  for (const Eigen::Vector3i& f : second.faces)
+    overlapping->faces.push_back(f + Eigen::Vector3i::Constant(offset));
+  auto open = std::make_shared<kct::Mesh>(*make_cube(0.1));
+  open->faces.pop_back();
+  open->faces.pop_back();
+  const std::vector<kct::Pose> poses{make_pose({0.3, 1.0, 0.2}, 0.7, {0.0, 0.0, 0.4}),
+                                     make_pose({1.0, 0.2, 0.0}, 2.1, {0.25, -0.1, 0.35}),
+                                     make_pose({0, 0, 1}, 0.0, {0.0, 0.0, 0.03}),
+                                     make_pose({0.0, 1.0, 0.0}, 1.2, {0.03, 0.01, 0.02})};
+  int compared = 0;
+  for (const std::shared_ptr<const kct::Mesh>& mesh :
+       {std::shared_ptr<const kct::Mesh>(overlapping),
+        std::shared_ptr<const kct::Mesh>(make_cube(0.1)), std::shared_ptr<const kct::Mesh>(open)}) {
+    const kct::Renderer renderer(mesh);
+    kct::RenderOptions options;
+    options.draw_color = false;
+    for (const kct::Pose& pose : poses) {
+      const cv::Mat expected = renderer.render(pose, kCamera, options).mask();
+      const cv::Mat silhouette = renderer.render_silhouette(pose, kCamera);
+      ASSERT_EQ(silhouette.type(), CV_8UC1);
+      ASSERT_EQ(silhouette.size(), expected.size());
+      EXPECT_EQ(cv::countNonZero(silhouette != expected), 0);
+      if (cv::countNonZero(expected) > 0) ++compared;
+    }
+  }
+  EXPECT_GE(compared, 10);  // most cases draw something
+}

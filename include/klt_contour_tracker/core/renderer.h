@@ -59,6 +59,11 @@ class Renderer {
   RenderOutput render(const Pose& object_to_camera, const PinholeCamera& camera,
                       const RenderOptions& options = {}) const;
 
+  /// render(...).mask() without the depth test or the depth and face buffers (the same
+  /// pixels; checked in the tests): CV_8U, 255 on the object. The colour search renders two
+  /// dozen silhouettes a frame.
+  cv::Mat render_silhouette(const Pose& object_to_camera, const PinholeCamera& camera) const;
+
   /// Orthographic face-index render looking along `view_direction_object` (object frame,
   /// from the eye towards the object), `resolution_px` square pixels covering the model's
   /// bounding sphere. Used by the visibility table (paper supplement, Sec. 3).
