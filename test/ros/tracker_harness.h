@@ -119,16 +119,28 @@ class Harness {
   bool ready() const { return loaded_ && connected_; }
   const std::string& name() const { return name_; }
 
-  /// Publishes one image + camera_info and waits for its status (and, when the status says a
-  /// pose went out, for the pose). Null on timeout.
+  /// Publishes one image + camera_info and waits for its status, the one stamped as the image
+  /// (and, when the status says a pose went out, for the pose). Null on timeout. Matched by
+  /// stamp: a status still on its way for an image published alone before (publish_image())
+  /// would otherwise be taken for this one's, and every later send() would read the status of
+  /// the frame before it.
   klt_contour_tracker::TrackerStatus::ConstPtr send(const sensor_msgs::ImagePtr& image,
                                                    const sensor_msgs::CameraInfo& info,
                                                    double timeout_s = 120.0) {
     const size_t before = statuses().size();
     info_pub_.publish(info);
     image_pub_.publish(image);
-    if (!wait_for([&] { return statuses().size() > before; }, timeout_s)) return nullptr;
-    const auto status = statuses().back();
+    klt_contour_tracker::TrackerStatus::ConstPtr status;
+    const auto arrived = [&] {
+      const auto all = statuses();
+      for (size_t i = before; i < all.size(); ++i)
+        if (all[i]->header.stamp == image->header.stamp) {
+          status = all[i];
+          return true;
+        }
+      return false;
+    };
+    if (!wait_for(arrived, timeout_s)) return nullptr;
     if (status->pose_published)
       wait_for([&] { return last_pose() && last_pose()->header.stamp == status->header.stamp; }, 5.0);
     return status;
