@@ -275,7 +275,8 @@ struct TrackerParams {
   /// 11.15: a safeguard, not a gain on the benchmark.
   double max_step_px = 0.0;
   /// ours: threads the tracker may use (KLT overlapped with the refinement's image work,
-  /// pyramid levels in parallel); results do not depend on it.
+  /// pyramid levels, re-acquisition hypotheses and the colour search in parallel); results do
+  /// not depend on it.
   int num_threads = 1;
 
   /// Throws std::invalid_argument naming the first bad field and its allowed range.
