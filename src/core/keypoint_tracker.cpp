@@ -145,6 +145,10 @@ int KeypointTracker::detect(const cv::Mat& gray, const Pose& object_to_camera,
   cv::goodFeaturesToTrack(small(crop), corners, params_.max_keypoints,
                           params_.corner_quality_level, params_.corner_min_distance_px * s,
                           mask(crop));
+  if (static_cast<int>(corners.size()) < params_.corner_fallback_below)
+    cv::goodFeaturesToTrack(small(crop), corners, params_.max_keypoints,
+                            params_.corner_fallback_quality_level, params_.corner_min_distance_px * s,
+                            mask(crop));
 
   // Anchor each corner on the mesh (surface_anchor.h).
   for (const cv::Point2f& corner_in_crop : corners) {

@@ -116,6 +116,43 @@ TEST_F(KeypointTrackerTest, FailsWithoutTextureAndAsksForRedetection) {
   EXPECT_TRUE(tracker.needs_redetection());
 }
 
+TEST_F(KeypointTrackerTest, FallsBackToFaintCornersWhenTheStrongOnesAreFew) {
+  // The box's texture faded to 20 % of its contrast and one black-and-white checker on it:
+  // relative to the checker's corners the texture's are below corner_quality_level (an
+  // untextured object whose only strong corners are a few edges), so few corners pass it.
+  const Pose pose = test::make_pose(0.4);
+  cv::Mat gray = gray_at(pose, 1);
+  const cv::Mat inside = renderer_.render(pose, camera_).mask();
+  const double mean = cv::mean(gray, inside)[0];
+  cv::Mat faded;
+  gray.convertTo(faded, CV_8U, 0.2, 0.8 * mean);
+  faded.copyTo(gray, inside);
+  const Eigen::Vector2d centre = camera_.project(pose * mesh_->bounding_box_center());
+  for (int row = 0; row < 2; ++row)
+    for (int col = 0; col < 2; ++col)
+      cv::rectangle(gray, cv::Rect(static_cast<int>(centre.x()) - 8 + 8 * col,
+                                   static_cast<int>(centre.y()) - 8 + 8 * row, 8, 8),
+                    cv::Scalar((row + col) % 2 ? 255 : 0), cv::FILLED);
+  KeypointTracker strict(mesh_, params_);
+  const int strong = strict.detect(gray, pose, camera_);
+  EXPECT_LT(strong, 30) << "the faded texture's corners should fall below the quality level";
+  TrackerParams params = params_;
+  params.corner_fallback_below = 30;
+  KeypointTracker tracker(mesh_, params);
+  const int detected = tracker.detect(gray, pose, camera_);
+  EXPECT_GE(detected, 3 * std::max(strong, 10)) << "the fallback should find the faint corners";
+  // They are anchored like any other: re-tracked on the same frame, all inliers at ~0 error
+  // (tolerance 0.1 px: faint corners localize less sharply).
+  const KeypointResult same = tracker.track(gray, pose, camera_);
+  ASSERT_TRUE(same.success);
+  EXPECT_LT(same.mean_reprojection_px, 0.1);
+  EXPECT_GE(same.inlier_ratio, 0.95);
+  // Enough corners at the quality level: the fallback changes nothing.
+  KeypointTracker textured(mesh_, params);
+  EXPECT_EQ(textured.detect(gray_at(pose, 1), pose, camera_),
+            KeypointTracker(mesh_, params_).detect(gray_at(pose, 1), pose, camera_));
+}
+
 TEST_F(KeypointTrackerTest, NoKeypointsWhenTheObjectIsOutOfView) {
   Pose behind = test::make_pose(0.4);
   behind.translation().x() = 5.0;  // far to the side: not in the image

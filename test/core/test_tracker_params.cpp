@@ -120,7 +120,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 86u);
+  EXPECT_EQ(fields.size(), 88u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -165,6 +165,16 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   EXPECT_FALSE(make_preset("paper").color_search);
   EXPECT_FALSE(make_preset("klt_only").color_search);
   EXPECT_EQ(make_preset("klt_only").keypoint_max_motion_deg, 0.0);
+  // The corner fallback is realtime's; paper and klt_only detect as before.
+  EXPECT_EQ(realtime.corner_fallback_below, 30);
+  EXPECT_EQ(make_preset("paper").corner_fallback_below, 0);
+  EXPECT_EQ(make_preset("klt_only").corner_fallback_below, 0);
+  bad = realtime;
+  bad.corner_fallback_below = -1;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = realtime;
+  bad.corner_fallback_quality_level = 0.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
 }  // namespace
