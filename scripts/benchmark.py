@@ -415,6 +415,7 @@ def stage_table(rows, configs, key_rows):
 REACQUIRE_WITHIN_FRAMES = 10
 SESSION_COLUMNS = ["losses", "re-acquired", "within %d frames" % REACQUIRE_WITHIN_FRAMES,
                    "within %d frames, right" % REACQUIRE_WITHIN_FRAMES,
+                   "within %d frames of being visible, right" % REACQUIRE_WITHIN_FRAMES,
                    "median frames to re-acquire", "frames lost"]
 
 
@@ -475,6 +476,35 @@ def reacquired_right_in_time(row):
     return right
 
 
+def reacquired_right_once_visible(row):
+    """Issue 11's measure: (right, losses) where losses are the losses after which the object is
+    visible again (at least HARD_MIN_VISIBLE of it, `visible_errors` not None) before the sequence
+    ends, and right are those of them re-acquired within REACQUIRE_WITHIN_FRAMES of the first such
+    frame (at or after the loss) with a right pose (error < WRONG_POSE_DIAMETERS diameters). A
+    re-acquisition before the object is back (on the background) is not right. None without a
+    trace or visibility."""
+    states, errors, visible = row.get("states"), row.get("errors", []), row.get("visible_errors")
+    if states is None or visible is None or not (len(states) == len(errors) == len(visible)):
+        return None
+    right = losses = 0
+    i = 1
+    while i < len(states):
+        if not (states[i - 1] == "tracking" and states[i] == "lost"):
+            i += 1
+            continue
+        back = next((k for k in range(i, len(states)) if visible[k] is not None), None)
+        end = next((k for k in range(i + 1, len(states)) if states[k] == "tracking"), None)
+        if back is not None:
+            losses += 1
+            if (end is not None and back <= end <= back + REACQUIRE_WITHIN_FRAMES and
+                    errors[end] < WRONG_POSE_DIAMETERS * row["diameter_m"]):
+                right += 1
+        if end is None:
+            break
+        i = end + 1
+    return right, losses
+
+
 def session_cells(rows):
     """Losses, re-acquisitions (all; within REACQUIRE_WITHIN_FRAMES, share of the losses; of
     those, the ones whose pose is right), the median number of frames from a loss to its
@@ -483,10 +513,13 @@ def session_cells(rows):
     within = sum(1 for f in frames if f <= REACQUIRE_WITHIN_FRAMES)
     losses = sum(int(r.get("losses", 0)) for r in rows)
     right = [reacquired_right_in_time(r) for r in rows]
+    once_visible = [reacquired_right_once_visible(r) for r in rows]
     middle = median(frames)
     return [str(losses), str(sum(int(r.get("reacquisitions", 0)) for r in rows)),
             count_share(within, losses),
             count_share(sum(right), losses) if None not in right else "-",
+            count_share(sum(v[0] for v in once_visible), sum(v[1] for v in once_visible))
+            if None not in once_visible else "-",
             "%g" % middle if middle is not None else "-", str(sum(int(r.get("frames_lost", 0)) for r in rows))]
 
 
@@ -869,10 +902,15 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
                  "before the sequence ends; *within %d frames*: counted from the loss, so the frames the "
                  "object spends outside the image (leave: %s) or behind the occluder count too; *right*: "
                  "of those, the ones whose pose at the re-acquisition frame is off by less than %g "
-                 "diameters (a re-acquisition on a distractor counts in the other columns); the "
+                 "diameters (a re-acquisition on a distractor counts in the other columns); *within %d "
+                 "frames of being visible, right* (issue 11's measure): of the losses after which the "
+                 "object is visible again (the share is of those), the ones re-acquired right within "
+                 "%d frames of the first frame at or after the loss where at least %d %% of it is in the image and "
+                 "not occluded (a re-acquisition before that frame is on something else, never right); the "
                  "median is over the re-acquired losses.\n"
                  % (REACQUIRE_WITHIN_FRAMES, leave_args[leave_args.index("--leave-frames") + 1],
-                    WRONG_POSE_DIAMETERS))
+                    WRONG_POSE_DIAMETERS, REACQUIRE_WITHIN_FRAMES, REACQUIRE_WITHIN_FRAMES,
+                    round(100 * HARD_MIN_VISIBLE)))
         L.append("| preset | condition | " + " | ".join(keys) + " |")
         L.append("|---|---|" + "---|" * len(keys))
         for p in labels:
