@@ -70,6 +70,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_tracked_search", "realtime", {"tracked_search_ratio": "0"}),
     # re-acquisition searches the whole frame (not only as far as the object could have moved)
     ("realtime_no_search_reach", "realtime", {"color_search_reach_diameters": "0"}),
+    # no second corner detection at a lower quality when few corners pass (untextured objects)
+    ("realtime_no_corner_fallback", "realtime", {"corner_fallback_below": "0"}),
     # keypoints anchored after a KLT failure kept even when the frame is judged bad
     ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
