@@ -4,7 +4,8 @@
 //
 //   track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]
 //                  [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]
-//                  [--max-frames N] [--max-image-pixels N] [--errors FILE] [--debug-dir DIR [--debug-every N]] [--quiet]
+//                  [--max-frames N] [--max-image-pixels N] [--errors FILE] [--score-model MESH]
+//                  [--debug-dir DIR [--debug-every N]] [--quiet]
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -31,6 +32,7 @@ void usage(const char* error) {
   std::cerr << "usage: track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]\n"
                "                      [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]\n"
                "                      [--max-frames N] [--max-image-pixels N] [--errors FILE]\n"
+               "                      [--score-model MESH]\n"
                "                      [--debug-dir DIR [--debug-every N]] [--trace FILE] [--quiet]\n"
                "  --model-scale S: metres per model unit (0.001 for millimetres). It applies to\n"
                "  everything in model units: the mesh, pose.txt as read, the poses written by --output\n"
@@ -40,6 +42,9 @@ void usage(const char* error) {
                "  The visibility table is cached in $XDG_CACHE_HOME (~/.cache)/klt_contour_tracker/visibility\n"
                "  (--param visibility_cache_dir=DIR to change, =\"\" for none).\n"
                "  --errors FILE writes the per-frame error delta_i (Sec. 4.1, metres), one a line.\n"
+               "  --score-model MESH: the object's true shape (same units and frame as --model), used for\n"
+               "  the errors and the diameter instead of --model: the tracker is given a model that is off\n"
+               "  the object (a CAD model or scan with a shape error), the score is against the object.\n"
                "  --debug-dir DIR writes the tracking overlay (contour, keypoints, axes, status) of every\n"
                "  N-th frame (default 1) as DIR/<frame>.png.\n"
                "  --trace FILE writes one CSV line per frame: status, state, quality, KLT tracked / inliers,\n"
@@ -56,6 +61,7 @@ void usage(const char* error) {
 
 struct Options {
   std::string sequence, model, preset = "realtime", output, summary_json, errors, debug_dir, trace;
+  std::string score_model;  ///< the object's true shape for scoring; empty = `model`
   int debug_every = 1;
   double model_scale = 1.0;
   int max_frames = -1;
@@ -77,6 +83,7 @@ Options parse(int argc, char** argv) {
          {"--output", store(o.output)},
          {"--summary-json", store(o.summary_json)},
          {"--errors", store(o.errors)},
+         {"--score-model", store(o.score_model)},
          {"--max-frames", store(o.max_frames)},
          {"--max-image-pixels", store(o.max_image_pixels)},
          kct_tools::flag("--quiet", o.quiet),
@@ -144,6 +151,11 @@ int main(int argc, char** argv) {
     if (sequence.poses.empty())
       throw std::runtime_error(options.sequence + "/pose.txt: missing; its first line is the initial pose");
     auto mesh = std::make_shared<kct::Mesh>(kct::load_mesh(options.model, units.metres_per_unit()));
+    // Scored against the object's true shape when it is not the model the tracker is given.
+    const auto score_mesh = options.score_model.empty()
+                                ? mesh
+                                : std::make_shared<kct::Mesh>(kct::load_mesh(options.score_model,
+                                                                             units.metres_per_unit()));
 
     if (!options.debug_dir.empty()) std::filesystem::create_directories(options.debug_dir);
     kct::SequenceRunOptions run_options;
@@ -256,7 +268,7 @@ int main(int argc, char** argv) {
         exit_code = 1;
       }
     } else {
-      const kct::SequenceScore score = kct::score_sequence(*mesh, run.object_to_camera, sequence.poses);
+      const kct::SequenceScore score = kct::score_sequence(*score_mesh, run.object_to_camera, sequence.poses);
       if (score.scored_frames < frames)
         std::cerr << "track_sequence: warning: pose.txt has " << sequence.poses.size() << " poses for "
                   << frames << " frames: only the first " << score.scored_frames << " are scored\n";
