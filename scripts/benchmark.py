@@ -201,6 +201,13 @@ def auc(errors, diameter):
     return 100.0 * sum(max(0.0, 0.2 - e / diameter) for e in errors) / len(errors)
 
 
+def first_frames_auc(rows, n):
+    """AUC over the first n frames of each row's sequence (its visible_errors: metres, None where
+    not scored), each error normalized by its row's diameter: presets tracked on different
+    numbers of frames, compared on the frames they share."""
+    return auc([e / r["diameter_m"] for r in rows for e in r["visible_errors"][:n] if e is not None], 1.0)
+
+
 def weighted_auc(rows):
     """AUC over all scored frames of `rows` (the AUC is a per-frame mean, so this is exact)."""
     n = sum(r["scored_frames"] for r in rows if r.get("auc") is not None)
@@ -622,7 +629,7 @@ def run_mismatch(args, configs, runner, data, docs_dir, tmp):
     models = {o: (mismatched_model(data, HARD_OBJECTS[o]["model"]),
                   os.path.join(data, "models", HARD_OBJECTS[o]["model"] + ".obj")) for o in objects}
     return run_hard(args, configs, runner, data, docs_dir, tmp, set_name="mismatch", folders=folders,
-                    models=models)
+                    models=models, folder_frames=frames)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -753,7 +760,7 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
                 scored = [e for e, v in zip(r["errors"], visible) if v >= HARD_MIN_VISIBLE]
                 r.update(preset=config[0], draw=draw, set=s, object=o, condition=c,
                          auc=auc(scored, r["diameter_m"]), scored_frames=len(scored),
-                         visible_errors=[(e / r["diameter_m"] if v >= HARD_MIN_VISIBLE else None)
+                         visible_errors=[(e if v >= HARD_MIN_VISIBLE else None)
                                          for e, v in zip(r["errors"], visible)])
                 rows.append(r)
             log("noise %-10s draw %d: AUC %s" % (config[0], draw, fmt(weighted_auc(
@@ -815,12 +822,9 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
     if len(caps) > 1:
         n = caps[0]
 
-        def first_n(rr):
-            return auc([e for r in rr for e in r["visible_errors"][:n] if e is not None], 1.0)
-
         def per_draw(label, **kw):
-            return [first_n([r for r in rows if r["preset"] == label and r["draw"] == d
-                             and all(r[k] == v for k, v in kw.items())]) for d in range(NOISE_DRAWS)]
+            return [first_frames_auc([r for r in rows if r["preset"] == label and r["draw"] == d
+                             and all(r[k] == v for k, v in kw.items())], n) for d in range(NOISE_DRAWS)]
         L.append("\n### Per object on the first %d frames (both sets; mean +- sd over the draws)\n" % n)
         L.append("Every preset on the first %d frames of each sequence (the frames the slowest preset tracks), "
                  "so that they compare; the paired rows are each draw's difference from %s on the same "
@@ -901,9 +905,10 @@ def run_photo(args, configs, runner, data, docs_dir, tmp):
 
 
 def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folders=None, condition_titles=None,
-             models=None):
-    """The hard sections (and the photo and mismatch sections, given their folders, condition titles
-    and models: object -> (the model the tracker is given, the true one it is scored against))."""
+             models=None, folder_frames=HARD_FRAMES):
+    """The hard sections (and the photo and mismatch sections, given their folders of
+    folder_frames frames, condition titles and models: object -> (the model the tracker is given,
+    the true one it is scored against))."""
     condition_titles = condition_titles or HARD_CONDITIONS
     frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or HARD_FRAMES)
     start = datetime.datetime.now(datetime.timezone.utc)
@@ -915,7 +920,7 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
     else:
         objects = list(dict.fromkeys(o for o, _ in folders))
         conditions = list(dict.fromkeys(c for _, c in folders))
-        frames = frames if set_name == "mismatch" else HARD_FRAMES
+        frames = folder_frames
     gen_s = time.time() - t0
     rows = []
     for config in configs:
@@ -971,8 +976,7 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
     n = caps[0]
 
     def first_n(rr):
-        errs = [(e / r["diameter_m"]) for r in rr for e in r["visible_errors"][:n] if e is not None]
-        return auc(errs, 1.0)
+        return first_frames_auc(rr, n)
     if len(caps) > 1:
         L.append("Comparable with the presets tracked on fewer frames: every preset on the first %d frames "
                  "of each sequence.\n" % n)
