@@ -9,7 +9,7 @@
 #     sensor effects; 4 objects x 6 conditions x 80 frames), hard2 (the same with other seeds and
 #     backgrounds: a change is judged on both), mismatch (the hard frames tracked with each model
 #     stretched 3 % and scored against the true one: a biased contour, as on real video), photo (4 objects x 3 conditions of hard
-#     trajectories path-traced by Blender's Cycles; rendering takes ~1 h the first time), noise (realtime, klt_only and each --variant on
+#     trajectories path-traced by Blender's Cycles; rendering takes ~1 h the first time), noise (realtime, klt_only, paper (first 40 frames) and each --variant on
 #     both hard sets from 5 slightly perturbed initial poses: how much of a difference is
 #     chance), real (ViSP's sequences from
 #     visp-images-data), opt (OPT-style groups; --objects/--frames/--track-frames apply to it)
