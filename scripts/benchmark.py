@@ -67,6 +67,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_texture_align", "realtime", {"texture_align_below": "0"}),
     # a KLT failure whose refined pose lost the colours waits for the declared loss to be searched
     ("realtime_no_extrapolated_search", "realtime", {"extrapolated_search_ratio": "0"}),
+    # ... and its find taken only above color_accept_ratio (not also when it beats the held pose)
+    ("realtime_no_extrapolated_accept", "realtime", {"extrapolated_accept_margin": "0"}),
     ("realtime_no_tracked_search", "realtime", {"tracked_search_ratio": "0"}),
     # re-acquisition searches the whole frame (not only as far as the object could have moved)
     ("realtime_no_search_reach", "realtime", {"color_search_reach_diameters": "0"}),

@@ -250,7 +250,8 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       unconfirmed_.reset();
     }
     if (best_contrast < bar.min_contrast || best.energy_after < bar.min_energy) return TrackResult();
-    if (best_contrast >= params_.color_accept_ratio * monitor_.color_level() || confirmed) {
+    if (best_contrast >= params_.color_accept_ratio * monitor_.color_level() || confirmed ||
+        best_contrast >= bar.accept_contrast) {
       // The taken pose confirms the next frame's best when it is at the same place: while the
       // track stays lost, a confirmed placement is not asked to wait a frame again.
       unconfirmed_ = best.object_to_camera;
@@ -340,6 +341,10 @@ void TrackingSession::search_if_faded(const Frame& frame, const cv::Mat& bgr, Se
     bar.min_contrast = held_contrast + kTrackedSearchMargin * level;
     bar.min_energy = std::max(kTrackedSearchMinEnergyRatio * held.energy_after,
                               kTrackedSearchMinEnergyLevel * monitor_.energy_level());
+  } else if (params_.extrapolated_accept_margin > 0.0) {
+    const double floor_ratio = params_.color_confirm_ratio > 0.0 ? params_.color_confirm_ratio : 0.5;
+    bar.accept_contrast =
+        std::max(held_contrast + params_.extrapolated_accept_margin * level, floor_ratio * level);
   }
   bool searched = false;
   const TrackResult found = reacquire(frame, bgr, searched, true, bar);

@@ -364,6 +364,49 @@ TEST(TrackingSession, AJumpIsSearchedForOnTheFrameItHappens) {
   }
 }
 
+/// extrapolated_accept_margin: the same jump, but the jump frame's box is washed out towards
+/// grey (blur and glare after a jerk): its right placement keeps less of the colour contrast than
+/// color_accept_ratio asks, yet far more than the held pose, which sits on the background. Without
+/// the margin the find is not taken on that frame; with it, it is.
+TEST(TrackingSession, AWashedOutJumpIsTakenWhenItBeatsTheHeldPoseByTheMargin) {
+  const ColourScene scene;
+  const Pose away = test::move(scene.start, 8.0, {0.2, 1.0, 0.3}, {-0.15, 0.1, 0.0});
+  TrackerParams params = quick_realtime();
+  params.color_search_reach_diameters = 0.0;  // as AJumpIsSearchedForOnTheFrameItHappens
+  const double realtime_margin = params.extrapolated_accept_margin;
+  ASSERT_GT(realtime_margin, 0.0) << "realtime takes such finds";
+  // The jump frame: the box blended a fifth of the way to the background's mean grey (its
+  // right placement then keeps ~0.65 x the contrast level: above the margin's floor of 0.5,
+  // below color_accept_ratio 0.8).
+  const cv::Mat sharp = test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 30);
+  const cv::Mat mask = scene.renderer.render_silhouette(away, scene.camera);
+  cv::Mat washed = sharp.clone();
+  cv::Mat grey(sharp.size(), sharp.type(), cv::mean(scene.background));
+  cv::Mat blend;
+  cv::addWeighted(sharp, 0.8, grey, 0.2, 0.0, blend);
+  blend.copyTo(washed, mask);
+  for (const double margin : {0.0, realtime_margin}) {
+    params.extrapolated_accept_margin = margin;
+    TrackingSession session(scene.mesh, params);
+    double stamp = 0.0;
+    ASSERT_NO_FATAL_FAILURE(track_start(session, scene, stamp));
+    const double level = session.monitor().color_level();
+    const SessionResult jump = session.track({washed, stamp});
+    ASSERT_EQ(jump.frame.status == TrackStatus::kReacquired, jump.searched);
+    if (margin == 0.0) {
+      EXPECT_FALSE(jump.searched) << "the washed-out box passes color_accept_ratio: no test";
+      EXPECT_GT(translation_error(jump.frame.object_to_camera, away), 0.05) << "no jump: no test";
+    } else {
+      EXPECT_TRUE(jump.searched);
+      // Tolerance: 1 cm and 3 deg, as the other re-acquisition tests.
+      EXPECT_LT(translation_error(jump.frame.object_to_camera, away), 0.01);
+      EXPECT_LT(rotation_error_deg(jump.frame.object_to_camera, away), 3.0);
+      EXPECT_LT(jump.color.contrast, params.color_accept_ratio * level)
+          << "taken by the accept ratio, not the margin: no test";
+    }
+  }
+}
+
 /// tracked_search_ratio: the red box jumps 18 cm sideways and the jump frame is not searched
 /// (extrapolated_search_ratio off) and its keypoints, laid at the held pose, are kept
 /// (drop_unconfirmed_anchors off): they lie on the textured background, which KLT then tracks

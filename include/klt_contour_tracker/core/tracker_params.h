@@ -183,6 +183,12 @@ struct TrackerParams {
   /// pose replaces the refined one when it passes color_accept_ratio (or color_confirm_ratio).
   /// A jump too fast for KLT and the shift search is found on the frame it happens.
   double extrapolated_search_ratio = 0.0;
+  /// ours (0 = off): ... and its find is also taken when its contrast beats the held pose's by
+  /// at least this x the contrast level and reaches color_confirm_ratio x the level (or, with
+  /// that off, half the level). After a jerk the blurred object's right placement lost some
+  /// contrast (measured: 0.42 at a level of 0.535, below color_accept_ratio 0.8) while the
+  /// pose the contour took sits on the background (-0.26).
+  double extrapolated_accept_margin = 0.0;
   /// ours (tracking session, 0 = off; needs color_search): on a frame KLT tracked whose refined
   /// pose's colour contrast is below this x the contrast level (and that rotation_check and
   /// texture_check left as it was), the colour search runs as while lost; its pose replaces the

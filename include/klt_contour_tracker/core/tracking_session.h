@@ -75,6 +75,9 @@ struct SessionStatistics {
 struct SearchBar {
   double min_contrast = -std::numeric_limits<double>::infinity();  ///< colour contrast
   double min_energy = -std::numeric_limits<double>::infinity();    ///< refined contour energy
+  /// A find at least this contrast is taken even below color_accept_ratio x the level (+inf:
+  /// only the accept ratio or a two-frame confirmation take it).
+  double accept_contrast = std::numeric_limits<double>::infinity();
 };
 
 /// Tracks one rigid object in one camera's stream with loss detection and re-acquisition.
