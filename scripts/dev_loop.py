@@ -1,0 +1,161 @@
+#!/usr/bin/env python3
+"""The developers' loop for a candidate change: the noise section's runs (both hard sets, the
+initial-pose draws), tracked by any track_sequence binary (a core-only build of a branch, say)
+with --param overrides, and a paired comparison of two such runs on the same draws. Scored with
+benchmark.py's own functions (auc, weighted_auc, reacquired_right_once_visible), so a dev-loop
+figure is the benchmark's. The data are the benchmark's (`scripts/benchmark.sh --section noise`
+generates them, or `dev_loop.py generate` under the built workspace's environment).
+
+  dev_loop.py generate                                   # the hard sets and their noise draws
+  dev_loop.py run LABEL [--binary PATH] [--draws 0,1] [--sets hard] [--objects can,toy]
+                  [--conditions occlusion] [--preset realtime] [--jobs 2] [--param NAME=VALUE ...]
+  dev_loop.py compare CANDIDATE BASE                      # paired per draw, per condition, runs
+
+Runs are written under $KCT_DATA/benchmark/dev/LABEL/ (poses, errors, trace, summary per run)
+and $KCT_DATA/benchmark/dev/LABEL.json (the scored rows)."""
+import argparse
+import concurrent.futures
+import csv
+import json
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark as B  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# As benchmark.py: the data under $KCT_DATA/benchmark, the visibility tables in data/cache.
+DATA = os.path.join(os.environ.get("KCT_DATA", os.path.join(ROOT, "data")), "benchmark")
+VISIBILITY_CACHE = os.path.join(ROOT, "data", "cache", "visibility")
+DEV = os.path.join(DATA, "dev")
+
+
+def folder_of(s, o, c, draw):
+    source = os.path.join(DATA, s, o, c)
+    return source, source if draw == 0 else os.path.join(DATA, "noise", s, o, c, "draw%d" % draw)
+
+
+def generate(_):
+    for o in B.HARD_OBJECTS:
+        B.ensure_model(DATA, B.HARD_OBJECTS[o]["model"])
+
+    def one(key):
+        s, o, c = key
+        source = B.hard_sequence(DATA, o, c, B.HARD_FRAMES, s)
+        for d in range(1, B.NOISE_DRAWS):
+            B.perturbed_sequence(DATA, source, s, o, c, d)
+    keys = [(s, o, c) for s in B.HARD_SETS for o in B.HARD_OBJECTS for c in B.HARD_CONDITIONS]
+    with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as ex:
+        list(ex.map(one, keys))
+
+
+def run(a):
+    out = os.path.join(DEV, a.label)
+    os.makedirs(out, exist_ok=True)
+    jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in a.sets.split(",")
+            for o in a.objects.split(",") for c in a.conditions.split(",")]
+
+    def one(job):
+        d, s, o, c = job
+        source, folder = folder_of(s, o, c, d)
+        base = os.path.join(out, "%s_%s_%s_d%d" % (s, o, c, d))
+        cmd = [a.binary, "--sequence", folder,
+               "--model", os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj"),
+               "--preset", a.preset, "--param", "visibility_cache_dir=" + VISIBILITY_CACHE,
+               "--output", base + ".poses.txt", "--summary-json", base + ".json",
+               "--trace", base + ".trace.csv", "--errors", base + ".errors.txt", "--quiet"]
+        for kv in a.params:
+            cmd += ["--param", kv]
+        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if proc.returncode:
+            return job, None, proc.stderr[-300:]
+        diameter = json.load(open(base + ".json"))["diameter_m"]
+        errors = [float(x) for x in open(base + ".errors.txt").read().split()]
+        visible = [float(l) for l in open(os.path.join(source, "visible.txt")) if not l.startswith("#")]
+        states = [t["state"] for t in csv.DictReader(open(base + ".trace.csv"))]
+        scored = [e for e, v in zip(errors, visible) if v >= B.HARD_MIN_VISIBLE]
+        row = dict(draw=d, set=s, object=o, condition=c, auc=B.auc(scored, diameter),
+                   scored_frames=len(scored), diameter_m=diameter, errors=errors, states=states,
+                   visible_errors=[e if v >= B.HARD_MIN_VISIBLE else None for e, v in zip(errors, visible)])
+        return job, row, ""
+    rows = []
+    with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
+        for job, row, err in ex.map(one, jobs):
+            if row is None:
+                print("FAILED %s: %s" % (job, err), file=sys.stderr)
+            else:
+                rows.append(row)
+    json.dump(dict(label=a.label, binary=a.binary, preset=a.preset, params=a.params, rows=rows),
+              open(out + ".json", "w"))
+    for d in sorted({r["draw"] for r in rows}):
+        print("draw %d: AUC %.2f" % (d, B.weighted_auc([r for r in rows if r["draw"] == d])))
+    print("all: AUC %.2f, re-acquired right within 10 frames of being visible: %d of %d" % (
+        (B.weighted_auc(rows),) + reacquisitions(rows)))
+    return 0 if len(rows) == len(jobs) else 1
+
+
+def reacquisitions(rows):
+    right = losses = 0
+    for r in rows:
+        got = B.reacquired_right_once_visible(r)
+        if got:
+            right, losses = right + got[0], losses + got[1]
+    return right, losses
+
+
+def compare(a):
+    load = lambda label: json.load(open(os.path.join(DEV, label + ".json")))["rows"]
+    key = lambda r: (r["set"], r["object"], r["condition"], r["draw"])
+    base = {key(r): r for r in load(a.base)}
+    cand = [r for r in load(a.candidate) if key(r) in base]
+    if not cand:
+        print("no run in common", file=sys.stderr)
+        return 1
+    ref = [base[key(r)] for r in cand]
+    draws = sorted({r["draw"] for r in cand})
+    diffs = [B.weighted_auc([r for r in cand if r["draw"] == d]) - B.weighted_auc([r for r in ref if r["draw"] == d])
+             for d in draws]
+    mean = sum(diffs) / len(diffs)
+    sd = (sum((x - mean) ** 2 for x in diffs) / max(1, len(diffs) - 1)) ** 0.5
+    print("%s %.2f, %s %.2f: paired %+.2f +- %.2f (%s)" % (a.candidate, B.weighted_auc(cand), a.base,
+                                                         B.weighted_auc(ref), mean, sd,
+                                                         " ".join("%+.2f" % x for x in diffs)))
+    print("re-acquired right: %d of %d, was %d of %d" % (reacquisitions(cand) + reacquisitions(ref)))
+    for c in B.HARD_CONDITIONS:
+        sel = [r for r in cand if r["condition"] == c]
+        if sel:
+            print("  %-10s %.2f -> %.2f" % (c, B.weighted_auc([base[key(r)] for r in sel]), B.weighted_auc(sel)))
+    changed = sorted((r["auc"] - base[key(r)]["auc"], key(r)) for r in cand if abs(r["auc"] - base[key(r)]["auc"]) > 0.05)
+    print("runs changed: %d (%d up, %d down)" % (len(changed), sum(x > 0 for x, _ in changed),
+                                                 sum(x < 0 for x, _ in changed)))
+    for x, k in changed[:5] + changed[-5:] if len(changed) > 10 else changed:
+        print("  %+.2f %s/%s/%s draw %d" % ((x,) + k))
+    return 0
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    sub.add_parser("generate")
+    r = sub.add_parser("run")
+    r.add_argument("label")
+    r.add_argument("--binary", default=os.path.join(ROOT, "build", "ws", "devel", "lib", "klt_contour_tracker",
+                                                    "track_sequence"))
+    r.add_argument("--draws", default=",".join(str(d) for d in range(B.NOISE_DRAWS)))
+    r.add_argument("--sets", default=",".join(B.HARD_SETS))
+    r.add_argument("--objects", default=",".join(B.HARD_OBJECTS))
+    r.add_argument("--conditions", default=",".join(B.HARD_CONDITIONS))
+    r.add_argument("--preset", default="realtime")
+    r.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    r.add_argument("--param", action="append", default=[], dest="params", metavar="NAME=VALUE",
+                   help="a track_sequence --param override (repeat for several)")
+    c = sub.add_parser("compare")
+    c.add_argument("candidate")
+    c.add_argument("base")
+    a = p.parse_args()
+    return {"generate": generate, "run": run, "compare": compare}[a.command](a) or 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
