@@ -210,6 +210,17 @@ def first_frames_auc(rows, n):
     return auc([e / r["diameter_m"] for r in rows for e in r["visible_errors"][:n] if e is not None], 1.0)
 
 
+def score_visible(row, source):
+    """Scores a tracked hard-style run `row` (Runner.track's summary) on the frames where at least
+    HARD_MIN_VISIBLE of the object is seen (`source`'s visible.txt): sets its auc, scored_frames
+    and visible_errors (metres, None where not scored); returns the visible fractions."""
+    visible = [float(l) for l in open(os.path.join(source, "visible.txt")) if not l.startswith("#")]
+    scored = [e for e, v in zip(row["errors"], visible) if v >= HARD_MIN_VISIBLE]
+    row.update(auc=auc(scored, row["diameter_m"]), scored_frames=len(scored),
+               visible_errors=[(e if v >= HARD_MIN_VISIBLE else None) for e, v in zip(row["errors"], visible)])
+    return visible
+
+
 def weighted_auc(rows):
     """AUC over all scored frames of `rows` (the AUC is a per-frame mean, so this is exact)."""
     n = sum(r["scored_frames"] for r in rows if r.get("auc") is not None)
@@ -280,15 +291,17 @@ class Runner:
     """Tracks a sequence with a configuration and returns the summary JSON (plus the per-frame
     errors), or None when track_sequence failed."""
 
-    def __init__(self, repo, results, reuse=()):
+    def __init__(self, repo, results, reuse=(), track_sequence=("rosrun", "klt_contour_tracker", "track_sequence")):
+        """track_sequence: the command that runs it (the built package's, or any binary)."""
         self.repo, self.results, self.reuse = repo, results, set(reuse)
+        self.track_sequence = list(track_sequence)
 
     def track(self, section, config, name, folder, model, max_frames=None, model_scale=None, score_model=None):
         label, preset, params = config
         out = os.path.join(self.results, section, label)
         os.makedirs(out, exist_ok=True)
         base = os.path.join(out, name.replace("/", "_"))
-        cmd = ["rosrun", "klt_contour_tracker", "track_sequence", "--sequence", folder, "--model", model,
+        cmd = self.track_sequence + ["--sequence", folder, "--model", model,
                "--preset", preset,
                "--param", "visibility_cache_dir=" + os.path.join(self.repo, "data", "cache", "visibility"),
                "--output", base + ".poses.txt", "--summary-json", base + ".json",
@@ -758,12 +771,8 @@ def run_noise(args, configs, runner, data, docs_dir, tmp):
                                  max_frames=min(cap, HARD_FRAMES) if cap else None)
                 if not r:
                     continue
-                visible = [float(l) for l in open(os.path.join(source, "visible.txt")) if not l.startswith("#")]
-                scored = [e for e, v in zip(r["errors"], visible) if v >= HARD_MIN_VISIBLE]
-                r.update(preset=config[0], draw=draw, set=s, object=o, condition=c,
-                         auc=auc(scored, r["diameter_m"]), scored_frames=len(scored),
-                         visible_errors=[(e if v >= HARD_MIN_VISIBLE else None)
-                                         for e, v in zip(r["errors"], visible)])
+                score_visible(r, source)
+                r.update(preset=config[0], draw=draw, set=s, object=o, condition=c)
                 rows.append(r)
             log("noise %-10s draw %d: AUC %s" % (config[0], draw, fmt(weighted_auc(
                 [r for r in rows if r["preset"] == config[0] and r["draw"] == draw]))))
@@ -934,14 +943,12 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
                              max_frames=min(cap, frames) if cap else None, score_model=score_model)
             if not r:
                 continue
-            visible = [float(l) for l in open(os.path.join(folder, "visible.txt")) if not l.startswith("#")]
-            scored = [e for e, v in zip(r["errors"], visible) if v >= HARD_MIN_VISIBLE]
+            visible = score_visible(r, folder)
             good = r.get("good")
             r["good_scored"] = None if good is None or len(good) != len(r["errors"]) else [
                 (g, e / r["diameter_m"]) for g, e, v in zip(good, r["errors"], visible) if v >= HARD_MIN_VISIBLE]
-            r.update(object=o, condition=c, auc=auc(scored, r["diameter_m"]), scored_frames=len(scored),
-                     normalized_errors=[e / r["diameter_m"] for e in scored],
-                     visible_errors=[(e if v >= HARD_MIN_VISIBLE else None) for e, v in zip(r["errors"], visible)])
+            r.update(object=o, condition=c,
+                     normalized_errors=[e / r["diameter_m"] for e in r["visible_errors"] if e is not None])
             log("%s %-20s %-7s %-10s AUC %5.2f  median %7.1f ms" % (set_name, config[0], o, c, r["auc"] or 0, r["median_ms"]))
             rows.append(r)
     duration = time.time() - t0

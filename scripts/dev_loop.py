@@ -15,25 +15,17 @@ Runs are written under $KCT_DATA/benchmark/dev/LABEL/ (poses, errors, trace, sum
 and $KCT_DATA/benchmark/dev/LABEL.json (the scored rows)."""
 import argparse
 import concurrent.futures
-import csv
 import json
 import os
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark as B  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-# As benchmark.py: the data under $KCT_DATA/benchmark, the visibility tables in data/cache.
+# As benchmark.py: the data under $KCT_DATA/benchmark.
 DATA = os.path.join(os.environ.get("KCT_DATA", os.path.join(ROOT, "data")), "benchmark")
-VISIBILITY_CACHE = os.path.join(ROOT, "data", "cache", "visibility")
 DEV = os.path.join(DATA, "dev")
-
-
-def folder_of(s, o, c, draw):
-    source = os.path.join(DATA, s, o, c)
-    return source, source if draw == 0 else os.path.join(DATA, "noise", s, o, c, "draw%d" % draw)
 
 
 def generate(_):
@@ -51,43 +43,28 @@ def generate(_):
 
 
 def run(a):
-    out = os.path.join(DEV, a.label)
-    os.makedirs(out, exist_ok=True)
+    # benchmark.py's Runner with this binary: its runs under DATA/dev/LABEL/.
+    runner = B.Runner(ROOT, DATA, track_sequence=[a.binary])
+    params = dict(kv.split("=", 1) for kv in a.params)
     jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in a.sets.split(",")
             for o in a.objects.split(",") for c in a.conditions.split(",")]
 
     def one(job):
         d, s, o, c = job
-        source, folder = folder_of(s, o, c, d)
-        base = os.path.join(out, "%s_%s_%s_d%d" % (s, o, c, d))
-        cmd = [a.binary, "--sequence", folder,
-               "--model", os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj"),
-               "--preset", a.preset, "--param", "visibility_cache_dir=" + VISIBILITY_CACHE,
-               "--output", base + ".poses.txt", "--summary-json", base + ".json",
-               "--trace", base + ".trace.csv", "--errors", base + ".errors.txt", "--quiet"]
-        for kv in a.params:
-            cmd += ["--param", kv]
-        proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        if proc.returncode:
-            return job, None, proc.stderr[-300:]
-        diameter = json.load(open(base + ".json"))["diameter_m"]
-        errors = [float(x) for x in open(base + ".errors.txt").read().split()]
-        visible = [float(l) for l in open(os.path.join(source, "visible.txt")) if not l.startswith("#")]
-        states = [t["state"] for t in csv.DictReader(open(base + ".trace.csv"))]
-        scored = [e for e, v in zip(errors, visible) if v >= B.HARD_MIN_VISIBLE]
-        row = dict(draw=d, set=s, object=o, condition=c, auc=B.auc(scored, diameter),
-                   scored_frames=len(scored), diameter_m=diameter, errors=errors, states=states,
-                   visible_errors=[e if v >= B.HARD_MIN_VISIBLE else None for e, v in zip(errors, visible)])
-        return job, row, ""
-    rows = []
+        source = os.path.join(DATA, s, o, c)
+        folder = B.perturbed_sequence(DATA, source, s, o, c, d)
+        r = runner.track("dev", (a.label, a.preset, params), "%s/%s/%s/d%d" % (s, o, c, d), folder,
+                         os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj"))
+        if not r:  # Runner logged the failure
+            return None
+        B.score_visible(r, source)
+        return dict(draw=d, set=s, object=o, condition=c, auc=r["auc"], scored_frames=r["scored_frames"],
+                    diameter_m=r["diameter_m"], errors=r["errors"], states=r["states"],
+                    visible_errors=r["visible_errors"])
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
-        for job, row, err in ex.map(one, jobs):
-            if row is None:
-                print("FAILED %s: %s" % (job, err), file=sys.stderr)
-            else:
-                rows.append(row)
+        rows = [r for r in ex.map(one, jobs) if r]
     json.dump(dict(label=a.label, binary=a.binary, preset=a.preset, params=a.params, rows=rows),
-              open(out + ".json", "w"))
+              open(os.path.join(DEV, a.label + ".json"), "w"))
     for d in sorted({r["draw"] for r in rows}):
         print("draw %d: AUC %.2f" % (d, B.weighted_auc([r for r in rows if r["draw"] == d])))
     print("all: AUC %.2f, re-acquired right within 10 frames of being visible: %d of %d" % (
