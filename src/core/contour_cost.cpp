@@ -58,6 +58,19 @@ bool cell_of(const Eigen::Vector3d& x, const Projection& project, const cv::Rect
   return cell_at(p.x(), p.y(), roi, cell);
 }
 
+/// PoseCostFrame::occlusion_mask looked up at a level's cell (nearest full-resolution pixel).
+struct Hidden {
+  const cv::Mat& mask;  ///< CV_8UC1 full resolution, or empty
+  double to_full;       ///< full-resolution px per level px
+  Hidden(const cv::Mat& m, double level_scale) : mask(m), to_full(1.0 / level_scale) {}
+  bool operator()(const cv::Rect& roi, const Cell& c) const {
+    if (mask.empty()) return false;
+    const int u = static_cast<int>((roi.x + c.x0 + c.ax) * to_full + 0.5);
+    const int v = static_cast<int>((roi.y + c.y0 + c.ay) * to_full + 0.5);
+    return u >= 0 && v >= 0 && u < mask.cols && v < mask.rows && mask.at<uchar>(v, u) != 0;
+  }
+};
+
 /// A camera-frame point's projection and inverse depth (shifted_energies()); `in_front` false
 /// when it is behind the camera (then nothing else is set).
 struct Projected {
@@ -247,6 +260,7 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
   Eigen::Matrix2d perp;
   perp << 0.0, -1.0, 1.0, 0.0;
 
+  const Hidden hidden(frame_->occlusion_mask, frame_->levels[level_].scale);
   double sum = 0.0;
   int kept = 0;
   for (const Segment& segment : segments_) {
@@ -264,7 +278,7 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
     for (int k = segment.first_sample; k < segment.end_sample; ++k) {
       const Eigen::Vector3d x = r * samples_[k] + t;
       Cell c;
-      if (!cell_of(x, project, images.roi, &c)) continue;
+      if (!cell_of(x, project, images.roi, &c) || hidden(images.roi, c)) continue;
       const int x0 = c.x0, y0 = c.y0;
       const double ax = c.ax, ay = c.ay;
       const Eigen::Vector2d g(bilinear(images.gx, x0, y0, ax, ay),
@@ -320,6 +334,7 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
   const LevelImages& images = levels_[level_];
   const PinholeCamera& camera = frame_->levels[level_].camera;
   const Projection project{camera.fx(), camera.fy(), camera.cx(), camera.cy()};
+  const Hidden hidden(frame_->occlusion_mask, frame_->levels[level_].scale);
   std::vector<Projected> ends(2 * segments_.size()), samples(samples_.size());
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     ends[2 * i] = projected(object_to_camera * segments_[i].a_object, project);
@@ -345,7 +360,8 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
       for (int k = segment.first_sample; k < segment.end_sample; ++k) {
         const Projected& q = samples[static_cast<std::size_t>(k)];
         Cell c;
-        if (!q.in_front || !cell_at(q.u + du * q.inv_z, q.v + dv * q.inv_z, images.roi, &c))
+        if (!q.in_front || !cell_at(q.u + du * q.inv_z, q.v + dv * q.inv_z, images.roi, &c) ||
+            hidden(images.roi, c))
           continue;
         sum += std::abs(bilinear(images.gx, c.x0, c.y0, c.ax, c.ay) * normal.x() +
                         bilinear(images.gy, c.x0, c.y0, c.ax, c.ay) * normal.y());

@@ -278,9 +278,12 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   std::vector<float> prediction_error_px;
   const double fb_limit_sq = params_.klt_forward_backward_px * params_.klt_forward_backward_px;
   for (size_t i = 0; i < image_points_.size(); ++i) {
-    if (!status_forward[i] || !status_backward[i]) continue;
     const cv::Point2f d = backward[i] - image_points_[i];
-    if (d.dot(d) > fb_limit_sq) continue;
+    if (!status_forward[i] || !status_backward[i] || d.dot(d) > fb_limit_sq) {
+      const cv::Point3f& p = object_points_[i];
+      result.lost_points_object.emplace_back(p.x, p.y, p.z);
+      continue;
+    }
     if (!camera.in_image({forward[i].x, forward[i].y})) continue;
     tracked_image.push_back(forward[i]);
     tracked_object.push_back(object_points_[i]);

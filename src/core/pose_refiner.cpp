@@ -128,9 +128,10 @@ double PoseRefiner::energy(const cv::Mat& gray, const PinholeCamera& camera,
 }
 
 RefineResult PoseRefiner::refine(const cv::Mat& gray, const PinholeCamera& camera,
-                                 const Pose& preliminary, const KeypointResult* keypoints) {
+                                 const Pose& preliminary, const KeypointResult* keypoints,
+                                 const cv::Mat& occlusion_mask) {
   if (params_.optimizer == "coarse_to_fine")
-    return refine_coarse_to_fine(gray, camera, preliminary, keypoints);
+    return refine_coarse_to_fine(gray, camera, preliminary, keypoints, occlusion_mask);
   const auto start = std::chrono::steady_clock::now();
   RefineResult result;
   result.object_to_camera = preliminary;
@@ -194,7 +195,8 @@ RefineResult PoseRefiner::refine(const cv::Mat& gray, const PinholeCamera& camer
 
 RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const PinholeCamera& camera,
                                                 const Pose& preliminary,
-                                                const KeypointResult* keypoints) {
+                                                const KeypointResult* keypoints,
+                                                const cv::Mat& occlusion_mask) {
   const auto start = std::chrono::steady_clock::now();
   if (prepared_gray_.empty() || prepared_gray_.data != gray.data ||
       prepared_gray_.size() != gray.size())
@@ -205,6 +207,7 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
 
   cost_frame_.preliminary_object_to_camera = preliminary;
   cost_frame_.keypoints = keypoints && keypoints->success ? keypoints : nullptr;
+  cost_frame_.occlusion_mask = occlusion_mask;
   CoarseToFineSettings settings;
   settings.iterations_per_level = params_.iterations_per_level;
   settings.max_step_px = params_.max_step_px;

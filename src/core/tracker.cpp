@@ -136,6 +136,38 @@ void Tracker::initialize(const Pose& object_to_camera) {
   state_ = State::kPendingFirstFrame;
   frames_since_init_ = 0;
   frames_since_detection_ = 0;
+  occluded_anchors_.clear();
+}
+
+cv::Mat Tracker::update_occlusion_mask(const KeypointResult& keypoints, const Pose& object_to_camera) {
+  const double radius_px = params_.occlusion_mask_radius_px;
+  ++tracked_frames_;
+  if (!(radius_px > 0.0)) {
+    occluded_anchors_.clear();
+    return cv::Mat();
+  }
+  const std::size_t lost = keypoints.lost_points_object.size();
+  // Most tracks failed: blur or a jump, not something in front of part of the object.
+  if (lost > 0 && 2 * lost <= lost + static_cast<std::size_t>(keypoints.tracked))
+    occluded_anchors_.emplace_back(tracked_frames_, keypoints.lost_points_object);
+  const int oldest = tracked_frames_ - params_.occlusion_mask_frames + 1;
+  occluded_anchors_.erase(
+      std::remove_if(occluded_anchors_.begin(), occluded_anchors_.end(),
+                     [&](const auto& entry) { return entry.first < oldest; }),
+      occluded_anchors_.end());
+  if (occluded_anchors_.empty()) return cv::Mat();
+  cv::Mat mask(camera_.height(), camera_.width(), CV_8UC1, cv::Scalar(0));
+  const int radius = std::max(1, static_cast<int>(std::lround(radius_px)));
+  for (const auto& entry : occluded_anchors_)
+    for (const Eigen::Vector3d& p : entry.second) {
+      const Eigen::Vector3d q = object_to_camera * p;
+      if (!(q.z() > 1e-6)) continue;
+      const Eigen::Vector2d uv = camera_.project(q);
+      if (!(std::abs(uv.x()) < 1e6 && std::abs(uv.y()) < 1e6)) continue;
+      cv::circle(mask, cv::Point(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y()))),
+                 radius, cv::Scalar(255), cv::FILLED);
+    }
+  return mask;
 }
 
 void Tracker::reset() {
@@ -366,9 +398,11 @@ TrackResult Tracker::track(const Frame& frame) {
   // Sec. 3.2-3.4: contour energy refinement.
   if (params_.refine && refiner_) {
     if (motion_prior_ && motion_) motion_prior_->set_prediction(predicted, motion_->sigma());
+    const cv::Mat occlusion_mask =
+        update_occlusion_mask(result.keypoints, result.preliminary_object_to_camera);
     const RefineResult refined =
         refiner_->refine(gray, camera_, result.preliminary_object_to_camera,
-                         result.keypoints.success ? &result.keypoints : nullptr);
+                         result.keypoints.success ? &result.keypoints : nullptr, occlusion_mask);
     apply_refinement(refined, result);
   }
 

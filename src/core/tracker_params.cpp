@@ -47,7 +47,8 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(texture_check_step_deg), KCT_FIELD(texture_check_every_frame),
       KCT_FIELD(texture_shift_search_below), KCT_FIELD(texture_align_below),
       KCT_FIELD(extrapolated_search_ratio), KCT_FIELD(extrapolated_accept_margin),
-      KCT_FIELD(tracked_search_ratio),
+      KCT_FIELD(tracked_search_ratio), KCT_FIELD(occlusion_mask_radius_px),
+      KCT_FIELD(occlusion_mask_frames),
       KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
       KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
       KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
@@ -193,6 +194,8 @@ void TrackerParams::validate() const {
   check_range(kOwner, "extrapolated_search_ratio", extrapolated_search_ratio, 0.0, 2.0);
   check_range(kOwner, "tracked_search_ratio", tracked_search_ratio, 0.0, 2.0);
   check_range(kOwner, "extrapolated_accept_margin", extrapolated_accept_margin, 0.0, 2.0);
+  check_range(kOwner, "occlusion_mask_radius_px", occlusion_mask_radius_px, 0.0, 500.0);
+  check_range(kOwner, "occlusion_mask_frames", occlusion_mask_frames, 1, 100);
   check_range(kOwner, "contour_weight", contour_weight, 0.0, 1e6);
   check_range(kOwner, "keypoint_weight", keypoint_weight, 0.0, 1e6);
   check_range(kOwner, "keypoint_sigma_px", keypoint_sigma_px, 0.01, 1000.0);

@@ -207,6 +207,44 @@ TEST_F(ContourCostTest, ShiftedEnergiesAreTheEnergiesOfTheShiftedPoses) {
   EXPECT_THROW(cost.shifted_energies(pose, {{0.0, 0.0, 0.01}}, &counts), std::invalid_argument);
 }
 
+TEST_F(ContourCostTest, PointsUnderTheOcclusionMaskAreLeftOut) {
+  ContourCost cost(extractor_, 2.0, 1.0);
+  cost.begin_frame(frame_);
+  cost.linearize(truth_, 0);
+  int all = 0;
+  const double energy_all = cost.energy(truth_, &all);
+  ASSERT_GT(all, 20);
+  // The left half of the image masked: only the points on the right are counted, on every
+  // level and by shifted_energies() alike.
+  const Eigen::Vector2d center_px = camera_.project(truth_ * frame_.center_object);
+  PoseCostFrame masked = frame_;
+  masked.occlusion_mask = cv::Mat(camera_.size(), CV_8UC1, cv::Scalar(0));
+  masked.occlusion_mask.colRange(0, static_cast<int>(center_px.x())).setTo(255);
+  cost.begin_frame(masked);
+  for (int level = 0; level < 3; ++level) {
+    cost.linearize(truth_, level);
+    int kept = 0;
+    cost.energy(truth_, &kept);
+    if (level == 0) {
+      // A symmetric box seen about its centre: about half the points (20% tolerance).
+      EXPECT_GT(kept, 0.3 * all);
+      EXPECT_LT(kept, 0.7 * all);
+      // Still the object's outline: the energy is the unmasked one's within 30%.
+      EXPECT_NEAR(cost.energy(truth_), energy_all, 0.3 * energy_all);
+    }
+    std::vector<int> counts;
+    cost.shifted_energies(truth_, {{0.0, 0.0, 0.0}}, &counts);
+    EXPECT_EQ(counts[0], kept) << "level " << level;
+  }
+  // Everything masked: no point left.
+  masked.occlusion_mask.setTo(255);
+  cost.begin_frame(masked);
+  cost.linearize(truth_, 0);
+  int none = -1;
+  EXPECT_EQ(cost.energy(truth_, &none), 0.0);
+  EXPECT_EQ(none, 0);
+}
+
 TEST_F(ContourCostTest, ResultDoesNotDependOnTheThreadCount) {
   ContourCost one(extractor_, 2.0, 1.0, 1), two(extractor_, 2.0, 1.0, 2);
   one.begin_frame(frame_);

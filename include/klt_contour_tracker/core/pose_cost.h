@@ -70,6 +70,9 @@ struct PoseCostFrame {
   /// KLT + PnP result of this frame (inliers in full-resolution px), or null when the
   /// preliminary pose was extrapolated.
   const KeypointResult* keypoints = nullptr;
+  /// CV_8UC1 at full resolution, nonzero where something may cover the object (contour points
+  /// there are not used), or empty; set with the KLT part (occlusion_mask_radius_px).
+  cv::Mat occlusion_mask;
 };
 
 /// Builds `levels` levels (>= 1) of a PoseCostFrame pyramid from a CV_8UC1 frame and its

@@ -60,8 +60,9 @@ class PoseRefiner {
   /// null when it was extrapolated (search area = Euler/translation box).
   /// With optimizer = coarse_to_fine, energy_before/after are Eq. 5 on the full-resolution
   /// level blurred by blur_sigma_px, both over the contour extracted at the refined pose.
+  /// `occlusion_mask` (coarse_to_fine only): PoseCostFrame::occlusion_mask for this call.
   RefineResult refine(const cv::Mat& gray, const PinholeCamera& camera, const Pose& preliminary,
-                      const KeypointResult* keypoints);
+                      const KeypointResult* keypoints, const cv::Mat& occlusion_mask = cv::Mat());
 
   /// coarse_to_fine only (a no-op otherwise): the frame's image work (pyramid, image
   /// derivatives, each cue's begin_frame) for `gray` (CV_8UC1, the frame refine() will get),
@@ -97,7 +98,8 @@ class PoseRefiner {
   Eigen::Vector3d center_object_ = Eigen::Vector3d::Zero();
 
   RefineResult refine_coarse_to_fine(const cv::Mat& gray, const PinholeCamera& camera,
-                                     const Pose& preliminary, const KeypointResult* keypoints);
+                                     const Pose& preliminary, const KeypointResult* keypoints,
+                                     const cv::Mat& occlusion_mask);
   /// shift_search_diameters (see TrackerParams): the image-plane shift of `preliminary` with
   /// the highest contour energy on the coarsest level, when it beats the unshifted pose.
   bool search_shift(const Pose& preliminary, Pose* shifted);

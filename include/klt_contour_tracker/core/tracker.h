@@ -7,6 +7,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "klt_contour_tracker/core/camera.h"
@@ -168,6 +169,13 @@ class Tracker {
   Pose pose_i2_ = Pose::Identity();  ///< pose of the frame before
   int frames_since_init_ = 0;
   int frames_since_detection_ = 0;
+  /// occlusion_mask_radius_px: the anchors whose track failed on each of the last
+  /// occlusion_mask_frames frames (frame number of track() calls, object-frame points).
+  std::vector<std::pair<int, std::vector<Eigen::Vector3d>>> occluded_anchors_;
+  int tracked_frames_ = 0;
+  /// Remembers this frame's failed anchors (unless most tracks failed) and returns the mask of
+  /// the remembered ones at `object_to_camera` (empty when off or none).
+  cv::Mat update_occlusion_mask(const KeypointResult& keypoints, const Pose& object_to_camera);
 };
 
 }  // namespace kct

@@ -279,6 +279,15 @@ struct TrackerParams {
   /// coarse px). Hard section (realtime, 24 sequences): 0 -> 10.62 mean AUC, 0.5 -> 10.75,
   /// 0.8 -> 10.86 (sensor effects 5.78 -> 7.86); no change on the OPT-style quick sequences.
   double shift_search_diameters = 0.0;
+  /// ours (coarse_to_fine only, 0 = off): contour points within this many px (full
+  /// resolution) of a KLT anchor whose track failed in the last occlusion_mask_frames frames
+  /// (projected at the preliminary pose) are left out of the contour energy. An occluder that
+  /// covers part of the object takes its anchors with it; its own outline, next to the hidden
+  /// part of the object's, would otherwise pull the contour onto it. Not used on a frame where
+  /// more than half of the tracks failed (blur, a jump: nothing tells the occluded part).
+  double occlusion_mask_radius_px = 0.0;
+  /// ... how many frames a failed anchor stays in the mask (>= 1).
+  int occlusion_mask_frames = 5;
   /// ours (0 = no limit): a coarse_to_fine step moves a model point by at most this many px of
   /// its pyramid level (CoarseToFineSettings::max_step_px). Without it a blurred frame with no
   /// keypoints turned the can 145 deg about its own axis in one step (hard/can/occlusion,
