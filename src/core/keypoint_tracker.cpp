@@ -280,8 +280,13 @@ KeypointResult KeypointTracker::track(const cv::Mat& gray, const Pose& object_to
   for (size_t i = 0; i < image_points_.size(); ++i) {
     const cv::Point2f d = backward[i] - image_points_[i];
     if (!status_forward[i] || !status_backward[i] || d.dot(d) > fb_limit_sq) {
-      const cv::Point3f& p = object_points_[i];
-      result.lost_points_object.emplace_back(p.x, p.y, p.z);
+      // A track that failed with its LK window (at the predicted position, else the last one)
+      // at the image border left the image: nothing covers the object there.
+      const cv::Point2f& at = prediction ? predicted[i] : image_points_[i];
+      if (camera.in_image({at.x, at.y}, params_.klt_window_px)) {
+        const cv::Point3f& p = object_points_[i];
+        result.lost_points_object.emplace_back(p.x, p.y, p.z);
+      }
       continue;
     }
     if (!camera.in_image({forward[i].x, forward[i].y})) continue;

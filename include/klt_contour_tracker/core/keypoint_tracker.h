@@ -36,7 +36,8 @@ struct KeypointResult {
   bool implausible_motion = false;
   KeypointInliers inlier_points;      ///< correspondences used by the search area
   /// Anchors whose track failed on this frame (LK status or the forward-backward check; not
-  /// those that left the image), object frame, m: where something may cover the object.
+  /// those that left the image or failed within klt_window_px of its border), object frame, m:
+  /// where something may cover the object.
   std::vector<Eigen::Vector3d> lost_points_object;
   double klt_ms = 0.0;  ///< wall time of the KLT tracking (normalization, pyramids, LK), ms
   double pnp_ms = 0.0;  ///< wall time of PnP + RANSAC + LM, ms
