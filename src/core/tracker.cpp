@@ -141,16 +141,16 @@ void Tracker::initialize(const Pose& object_to_camera) {
 
 cv::Mat Tracker::update_occlusion_mask(const KeypointResult& keypoints, const Pose& object_to_camera) {
   const double radius_px = params_.occlusion_mask_radius_px;
-  ++tracked_frames_;
   if (!(radius_px > 0.0)) {
     occluded_anchors_.clear();
     return cv::Mat();
   }
+  // Frames are numbered by frames_since_init_ (this frame's is counted after the refinement).
   const std::size_t lost = keypoints.lost_points_object.size();
   // Most tracks failed: blur or a jump, not something in front of part of the object.
-  if (lost > 0 && 2 * lost <= lost + static_cast<std::size_t>(keypoints.tracked))
-    occluded_anchors_.emplace_back(tracked_frames_, keypoints.lost_points_object);
-  const int oldest = tracked_frames_ - params_.occlusion_mask_frames + 1;
+  if (lost > 0 && lost <= static_cast<std::size_t>(keypoints.tracked))
+    occluded_anchors_.emplace_back(frames_since_init_, keypoints.lost_points_object);
+  const int oldest = frames_since_init_ - params_.occlusion_mask_frames + 1;
   occluded_anchors_.erase(
       std::remove_if(occluded_anchors_.begin(), occluded_anchors_.end(),
                      [&](const auto& entry) { return entry.first < oldest; }),

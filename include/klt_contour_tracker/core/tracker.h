@@ -170,9 +170,8 @@ class Tracker {
   int frames_since_init_ = 0;
   int frames_since_detection_ = 0;
   /// occlusion_mask_radius_px: the anchors whose track failed on each of the last
-  /// occlusion_mask_frames frames (frame number of track() calls, object-frame points).
+  /// occlusion_mask_frames frames (frames_since_init_ of that frame, object-frame points).
   std::vector<std::pair<int, std::vector<Eigen::Vector3d>>> occluded_anchors_;
-  int tracked_frames_ = 0;
   /// Remembers this frame's failed anchors (unless most tracks failed) and returns the mask of
   /// the remembered ones at `object_to_camera` (empty when off or none).
   cv::Mat update_occlusion_mask(const KeypointResult& keypoints, const Pose& object_to_camera);
