@@ -72,6 +72,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_tracked_search", "realtime", {"tracked_search_ratio": "0"}),
     # contour points next to anchors whose KLT track just failed (an occluder) are kept
     ("realtime_no_occlusion_mask", "realtime", {"occlusion_mask_radius_px": "0"}),
+    # while lost, a frame recovers on its contour and keypoints alone (a static distractor too)
+    ("realtime_no_recovery_check", "realtime", {"color_recover_ratio": "0", "color_recover_min_visible": "0"}),
     # re-acquisition searches the whole frame (not only as far as the object could have moved)
     ("realtime_no_search_reach", "realtime", {"color_search_reach_diameters": "0"}),
     # no second corner detection at a lower quality when few corners pass (untextured objects)

@@ -634,6 +634,8 @@ SessionResult TrackingSession::track(const Frame& frame) {
   rule.contour_veto_ratio = params_.color_contour_veto_ratio;
   rule.keypoint_veto_inliers = params_.color_keypoint_veto_inliers;
   rule.vanished_ratio = params_.color_vanished_ratio;
+  rule.recover_ratio = params_.color_recover_ratio;
+  rule.recover_min_visible = params_.color_recover_min_visible;
   result.state = monitor_.update(result.frame, result.color, rule);
   if (params_.drop_unconfirmed_anchors && result.frame.status == TrackStatus::kExtrapolated &&
       !monitor_.last_good())

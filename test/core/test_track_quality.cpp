@@ -176,6 +176,55 @@ TEST(TrackQuality, AWeakColourModelIsNotEvidence) {
   EXPECT_TRUE(monitor.last_good());
 }
 
+TEST(TrackQuality, WhileLostARecoveryNeedsTheColoursAndMostOfTheSilhouetteInTheImage) {
+  TrackQualityParams params;
+  params.energy_level_smoothing = 1.0;  // levels = the last good frame's
+  params.lost_after_bad_frames = 1;
+  params.recover_after_good_frames = 1;
+  ColorLossRule rule;
+  rule.lost_ratio = 0.6;
+  rule.contour_veto_ratio = 0.85;
+  rule.keypoint_veto_inliers = 100;
+  rule.vanished_ratio = 0.15;
+  rule.recover_ratio = 0.5;
+  rule.recover_min_visible = 0.5;
+  ColorEvidence color;
+  color.valid = true;
+  color.visible_fraction = 1.0;
+  // A static distractor: energy at the level, 150 KLT inliers at a ratio of 1, contrast 0.3.
+  TrackResult held = refined_result(10.0, true, 1.0);
+  held.keypoints.inliers = 150;
+  TrackQualityMonitor monitor = monitor_at_levels(params, rule);  // energy 10, colour 0.8
+  // While tracking, 0.3 < 0.6 x 0.8 is faded but the vetoes hold: good (and the colour level
+  // follows it to 0.3).
+  color.contrast = 0.3;
+  EXPECT_EQ(monitor.update(held, color, rule), TrackState::kTracking);
+  EXPECT_TRUE(monitor.last_good());
+  // Lost (out of view) ...
+  ColorEvidence outside = color;
+  outside.visible_fraction = 0.05;
+  EXPECT_EQ(monitor.update(held, outside, rule), TrackState::kLost);
+  // ... a frame whose contrast is below 0.5 x the level (0.1 < 0.15) does not recover, however
+  // well the contour and the keypoints hold.
+  color.contrast = 0.1;
+  EXPECT_EQ(monitor.update(held, color, rule), TrackState::kLost);
+  EXPECT_FALSE(monitor.last_good());
+  // The colours right but only 40% of the silhouette in the image: not yet.
+  color.contrast = 0.3;
+  color.visible_fraction = 0.4;
+  EXPECT_EQ(monitor.update(held, color, rule), TrackState::kLost);
+  // Both: recovered.
+  color.visible_fraction = 0.6;
+  EXPECT_EQ(monitor.update(held, color, rule), TrackState::kTracking);
+  // With the rule off (0), the contour's veto recovers the low-contrast frame as before.
+  rule.recover_ratio = rule.recover_min_visible = 0.0;
+  TrackQualityMonitor off = monitor_at_levels(params, rule);
+  EXPECT_EQ(off.update(held, outside, rule), TrackState::kLost);
+  color.contrast = 0.3;  // vetoed: 0.3 >= 0.15 x 0.8
+  color.visible_fraction = 0.4;
+  EXPECT_EQ(off.update(held, color, rule), TrackState::kTracking);
+}
+
 TEST(TrackQuality, LostAfterTheStatedBadFramesAndRecoversAfterTheStatedGoodFrames) {
   TrackQualityParams params;
   params.lost_after_bad_frames = 3;

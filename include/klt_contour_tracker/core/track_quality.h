@@ -48,6 +48,13 @@ struct ColorLossRule {
   /// ... unless (either veto) its contrast is below this x the colour level (the outline's
   /// inside has lost the object's colours: it lies on the background).
   double vanished_ratio = 0.0;
+  /// 0 = off. While LOST, a frame counts towards recovery only when its contrast is at least
+  /// this x the colour level (no veto applies: a static distractor keeps its outline and its
+  /// keypoints as well as the object does) ...
+  double recover_ratio = 0.0;
+  /// ... and at least this share of its silhouette is inside the image (0 = off): a pose mostly
+  /// outside the image has too little outline and colour to be told from a distractor.
+  double recover_min_visible = 0.0;
 };
 
 /// Thresholds of the quality score and the state machine (all ours).

@@ -116,6 +116,12 @@ struct TrackerParams {
   /// ratio >= 0.95 (same exception).
   int color_keypoint_veto_inliers = 0;
   double color_vanished_ratio = 0.15;   ///< see color_contour_veto_ratio
+  /// ours (0 = off): while LOST, a frame counts towards recovery only when its colour contrast
+  /// is at least this x the contrast level, whatever its contour energy and keypoints ...
+  double color_recover_ratio = 0.0;
+  /// ours (0 = off): ... and at least this share of its silhouette is inside the image
+  /// (track_quality.h, ColorLossRule::recover_min_visible).
+  double color_recover_min_visible = 0.0;
   double color_accept_ratio = 0.6;      ///< re-acquire from a placement above this share
   /// Re-acquisition refines the best color_search_placements colour placements, each also
   /// turned by +-color_search_rotation_deg about the camera axes (0: not turned), and the last
