@@ -69,8 +69,10 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
   if (color.valid && result.status != TrackStatus::kInitialized) {
     constexpr double kMinVisibleFraction = 0.1;  // the object cannot be tracked out of view
     const bool out_of_view = color.visible_fraction < kMinVisibleFraction;
-    const bool faded = color.visible_fraction >= 0.3 && has_color_level_ &&
-                       color_level_ >= kMinColorLevel &&
+    // Colours are evidence only once their level shows they separate the object (faded and
+    // unconfirmed_recovery both ask this).
+    const bool color_usable = has_color_level_ && color_level_ >= kMinColorLevel;
+    const bool faded = color.visible_fraction >= 0.3 && color_usable &&
                        color.contrast < rule.lost_ratio * color_level_;
     // The contour's veto (ours): measured on 48 hard sequences, a perfect track (2 mm error,
     // 120 of 123 KLT inliers) lost its colour contrast to half the level under a shadow and was
@@ -87,7 +89,7 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
     // pose was off, 10 of them on a static distractor the keypoints held while the object was
     // outside the image.
     const bool unconfirmed_recovery =
-        state_ == TrackState::kLost && has_color_level_ && color_level_ >= kMinColorLevel &&
+        state_ == TrackState::kLost && color_usable &&
         ((rule.recover_ratio > 0.0 && !(color.contrast >= rule.recover_ratio * color_level_)) ||
          (rule.recover_min_visible > 0.0 && color.visible_fraction < rule.recover_min_visible));
     if (out_of_view || (faded && !vetoed) || unconfirmed_recovery) {

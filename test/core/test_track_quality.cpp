@@ -216,11 +216,12 @@ TEST(TrackQuality, WhileLostARecoveryNeedsTheColoursAndMostOfTheSilhouetteInTheI
   // Both: recovered.
   color.visible_fraction = 0.6;
   EXPECT_EQ(monitor.update(held, color, rule), TrackState::kTracking);
-  // With the rule off (0), the contour's veto recovers the low-contrast frame as before.
+  // With the rule off (0), the contour's veto recovers a frame the rule refuses on both counts
+  // (contrast 0.3 < 0.5 x 0.8, 40% in the image), as before.
   rule.recover_ratio = rule.recover_min_visible = 0.0;
-  TrackQualityMonitor off = monitor_at_levels(params, rule);
+  TrackQualityMonitor off = monitor_at_levels(params, rule);  // colour level 0.8
   EXPECT_EQ(off.update(held, outside, rule), TrackState::kLost);
-  color.contrast = 0.3;  // vetoed: 0.3 >= 0.15 x 0.8
+  color.contrast = 0.3;  // faded (< 0.6 x 0.8) but vetoed: 0.3 >= 0.15 x 0.8
   color.visible_fraction = 0.4;
   EXPECT_EQ(off.update(held, color, rule), TrackState::kTracking);
 }
