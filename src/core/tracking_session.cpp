@@ -633,6 +633,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   rule.lost_ratio = params_.color_lost_ratio;
   rule.contour_veto_ratio = params_.color_contour_veto_ratio;
   rule.keypoint_veto_inliers = params_.color_keypoint_veto_inliers;
+  rule.keypoint_veto_inlier_ratio = params_.color_keypoint_veto_inlier_ratio;
   rule.vanished_ratio = params_.color_vanished_ratio;
   rule.recover_ratio = params_.color_recover_ratio;
   rule.recover_min_visible = params_.color_recover_min_visible;

@@ -158,6 +158,18 @@ TEST(TrackQuality, TheContourOrKltVetoAFadedColourVerdictUnlessTheColoursVanishe
   klt.keypoints.inliers = 99;
   fresh.update(klt, color, rule);
   EXPECT_FALSE(fresh.last_good());
+  // The ratio is the rule's: at keypoint_veto_inlier_ratio 0.9 (realtime's), 150 inliers at a
+  // ratio of 0.92 (an occluder's edge costs a few) veto it, at 0.89 they do not.
+  rule.keypoint_veto_inlier_ratio = 0.9;
+  TrackQualityMonitor occluded = monitor_at_levels(params, rule);
+  klt.keypoints.inliers = 150;
+  klt.keypoints.inlier_ratio = 0.92;
+  occluded.update(klt, color, rule);
+  EXPECT_TRUE(occluded.last_good());
+  TrackQualityMonitor fewer = monitor_at_levels(params, rule);  // (the vetoed frame set the level)
+  klt.keypoints.inlier_ratio = 0.89;
+  fewer.update(klt, color, rule);
+  EXPECT_FALSE(fewer.last_good());
 }
 
 TEST(TrackQuality, AWeakColourModelIsNotEvidence) {

@@ -120,7 +120,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 93u);
+  EXPECT_EQ(fields.size(), 94u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

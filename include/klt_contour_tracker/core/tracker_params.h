@@ -113,8 +113,9 @@ struct TrackerParams {
   /// color_vanished_ratio x the colour level (track_quality.h, ColorLossRule).
   double color_contour_veto_ratio = 0.0;
   /// ours (0 = off): ... or while KLT keeps at least this many RANSAC inliers at an inlier
-  /// ratio >= 0.95 (same exception).
+  /// ratio >= color_keypoint_veto_inlier_ratio (same exception).
   int color_keypoint_veto_inliers = 0;
+  double color_keypoint_veto_inlier_ratio = 0.95;  ///< see color_keypoint_veto_inliers
   double color_vanished_ratio = 0.15;   ///< see color_contour_veto_ratio
   /// ours (0 = off): while LOST, a frame counts towards recovery only when its colour contrast
   /// is at least this x the contrast level, whatever its contour energy and keypoints ...
