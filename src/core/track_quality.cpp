@@ -3,7 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
 
 namespace kct {
 namespace {
@@ -28,6 +31,26 @@ void TrackQualityParams::validate() const {
   check_range(kOwner, "lost_after_bad_frames", lost_after_bad_frames, 1, 1000);
   check_range(kOwner, "recover_after_good_frames", recover_after_good_frames, 1, 1000);
   check_range(kOwner, "reacquire_search_scale", reacquire_search_scale, 1.0, 10.0);
+}
+
+void set_quality_param(TrackQualityParams& params, const std::string& name, const std::string& value) {
+  const auto parse = [&](auto& field) {
+    std::istringstream in(value);
+    std::decay_t<decltype(field)> parsed{};
+    in >> parsed;
+    if (value.empty() || in.fail() || !(in >> std::ws).eof())
+      throw std::invalid_argument(std::string(kOwner) + "." + name + ": '" + value.substr(0, 40) +
+                                  "' is not a" + (std::is_integral_v<decltype(parsed)> ? " whole" : "") +
+                                  " number");
+    field = parsed;
+  };
+  if (name == "energy_weight") return parse(params.energy_weight);
+  if (name == "min_quality") return parse(params.min_quality);
+  if (name == "energy_level_smoothing") return parse(params.energy_level_smoothing);
+  if (name == "lost_after_bad_frames") return parse(params.lost_after_bad_frames);
+  if (name == "recover_after_good_frames") return parse(params.recover_after_good_frames);
+  if (name == "reacquire_search_scale") return parse(params.reacquire_search_scale);
+  throw std::invalid_argument("unknown quality parameter '" + name.substr(0, 60) + "'");
 }
 
 TrackQualityMonitor::TrackQualityMonitor(const TrackQualityParams& params) : params_(params) {

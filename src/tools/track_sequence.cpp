@@ -22,6 +22,7 @@
 #include "klt_contour_tracker/core/model_units.h"
 #include "klt_contour_tracker/core/sequence_io.h"
 #include "klt_contour_tracker/core/sequence_run.h"
+#include "klt_contour_tracker/core/track_quality.h"
 #include "klt_contour_tracker/core/tracker.h"
 #include "tool_args.h"
 
@@ -30,10 +31,14 @@ namespace {
 void usage(const char* error) {
   if (error) std::cerr << "track_sequence: " << error << "\n";
   std::cerr << "usage: track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]\n"
-               "                      [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]\n"
+               "                      [--param NAME=VALUE ...] [--quality NAME=VALUE ...]\n"
+               "                      [--output FILE] [--summary-json FILE]\n"
                "                      [--max-frames N] [--max-image-pixels N] [--errors FILE]\n"
                "                      [--score-model MESH]\n"
                "                      [--debug-dir DIR [--debug-every N]] [--trace FILE] [--quiet]\n"
+               "  --quality NAME=VALUE: the session's loss / recovery thresholds, as the nodelet's\n"
+               "  parameters of the same names (lost_after_bad_frames, recover_after_good_frames,\n"
+               "  min_quality, energy_weight, energy_level_smoothing, reacquire_search_scale).\n"
                "  --model-scale S: metres per model unit (0.001 for millimetres). It applies to\n"
                "  everything in model units: the mesh, pose.txt as read, the poses written by --output\n"
                "  (in model units, as read). Errors and ADD are reported in metres / mm regardless.\n"
@@ -68,6 +73,7 @@ struct Options {
   long long max_image_pixels = 4096LL * 4096;
   bool quiet = false;
   std::vector<std::pair<std::string, std::string>> overrides;
+  kct::TrackQualityParams quality;  ///< --quality NAME=VALUE, as the nodelet's parameters
 };
 
 Options parse(int argc, char** argv) {
@@ -94,6 +100,12 @@ Options parse(int argc, char** argv) {
             const auto eq = kv.find('=');
             if (eq == std::string::npos) throw std::invalid_argument("takes NAME=VALUE");
             o.overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+          }},
+         {"--quality", [&o](const std::string& kv) {
+            const auto eq = kv.find('=');
+            if (eq == std::string::npos) throw std::invalid_argument("takes NAME=VALUE");
+            kct::set_quality_param(o.quality, kv.substr(0, eq), kv.substr(eq + 1));
+            o.quality.validate();
           }}});
     if (!run) usage(nullptr);
   } catch (const std::invalid_argument& e) {
@@ -161,6 +173,7 @@ int main(int argc, char** argv) {
     kct::SequenceRunOptions run_options;
     run_options.max_frames = options.max_frames > 0 ? static_cast<size_t>(options.max_frames) : 0;
     run_options.max_image_pixels = options.max_image_pixels;
+    run_options.quality = options.quality;
     size_t frames = sequence.image_paths.size();
     if (options.max_frames > 0) frames = std::min(frames, static_cast<size_t>(options.max_frames));
     // Per-stage times of the tracked frames (not the first), for the benchmark's stage table.

@@ -304,6 +304,33 @@ TEST(TrackQuality, InitializationForgetsTheEnergyLevel) {
   EXPECT_NEAR(monitor.score(refined_result(5.0, false, 0.0)), 0.7, 1e-12);
 }
 
+TEST(TrackQuality, QualityParametersAreSetByNameAsTheNodeletsAre) {
+  TrackQualityParams params;
+  set_quality_param(params, "lost_after_bad_frames", "8");
+  set_quality_param(params, "recover_after_good_frames", "2");
+  set_quality_param(params, "min_quality", "0.4");
+  set_quality_param(params, "energy_weight", "0.6");
+  set_quality_param(params, "energy_level_smoothing", "0.2");
+  set_quality_param(params, "reacquire_search_scale", "3");
+  EXPECT_EQ(params.lost_after_bad_frames, 8);
+  EXPECT_EQ(params.recover_after_good_frames, 2);
+  EXPECT_DOUBLE_EQ(params.min_quality, 0.4);
+  EXPECT_DOUBLE_EQ(params.energy_weight, 0.6);
+  EXPECT_DOUBLE_EQ(params.energy_level_smoothing, 0.2);
+  EXPECT_DOUBLE_EQ(params.reacquire_search_scale, 3.0);
+  EXPECT_NO_THROW(params.validate());
+  // Unknown names, text that is not a number, a fraction for a frame count: refused, unchanged.
+  EXPECT_THROW(set_quality_param(params, "lost_after", "8"), std::invalid_argument);
+  EXPECT_THROW(set_quality_param(params, "min_quality", "high"), std::invalid_argument);
+  EXPECT_THROW(set_quality_param(params, "min_quality", ""), std::invalid_argument);
+  EXPECT_THROW(set_quality_param(params, "lost_after_bad_frames", "2.5"), std::invalid_argument);
+  EXPECT_EQ(params.lost_after_bad_frames, 8);
+  EXPECT_DOUBLE_EQ(params.min_quality, 0.4);
+  // The range is validate()'s.
+  set_quality_param(params, "min_quality", "1.5");
+  EXPECT_THROW(params.validate(), std::invalid_argument);
+}
+
 TEST(TrackQuality, ParametersAreValidated) {
   TrackQualityParams params;
   EXPECT_NO_THROW(params.validate());

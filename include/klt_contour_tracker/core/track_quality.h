@@ -77,6 +77,13 @@ struct TrackQualityParams {
   void validate() const;
 };
 
+/// Sets one field of `params` by name from text, as the nodelet's parameters of the same names
+/// (energy_weight, min_quality, energy_level_smoothing, lost_after_bad_frames,
+/// recover_after_good_frames, reacquire_search_scale) set it: the offline tools take the same
+/// settings. Throws std::invalid_argument for an unknown name or a value that is not a number
+/// (whole for the frame counts); the range is checked by validate().
+void set_quality_param(TrackQualityParams& params, const std::string& name, const std::string& value);
+
 /// Scores TrackResults and runs the state machine. Transitions:
 /// WAITING_FOR_POSE -> TRACKING on on_initialized(); TRACKING -> LOST after
 /// lost_after_bad_frames bad frames in a row; LOST -> TRACKING after recover_after_good_frames
