@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -35,14 +34,7 @@ void TrackQualityParams::validate() const {
 
 void set_quality_param(TrackQualityParams& params, const std::string& name, const std::string& value) {
   const auto parse = [&](auto& field) {
-    std::istringstream in(value);
-    std::decay_t<decltype(field)> parsed{};
-    in >> parsed;
-    if (value.empty() || in.fail() || !(in >> std::ws).eof())
-      throw std::invalid_argument(std::string(kOwner) + "." + name + ": '" + value.substr(0, 40) +
-                                  "' is not a" + (std::is_integral_v<decltype(parsed)> ? " whole" : "") +
-                                  " number");
-    field = parsed;
+    field = parse_number<std::decay_t<decltype(field)>>(kOwner, name, value);
   };
   if (name == "energy_weight") return parse(params.energy_weight);
   if (name == "min_quality") return parse(params.min_quality);

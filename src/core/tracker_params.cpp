@@ -71,18 +71,13 @@ const std::vector<std::pair<const char*, Field>>& fields() {
 
 template <typename T>
 T parse(const std::string& name, const std::string& text) {
-  std::istringstream in(text);
-  T value{};
   if constexpr (std::is_same_v<T, bool>) {
     if (text == "true" || text == "1") return true;
     if (text == "false" || text == "0") return false;
     throw std::invalid_argument("TrackerParams." + name + ": '" + text + "' is not true/false");
   } else {
-    in >> value;
-    if (in.fail() || !(in >> std::ws).eof())
-      throw std::invalid_argument("TrackerParams." + name + ": '" + text + "' is not a number");
+    return parse_number<T>(kOwner, name, text);
   }
-  return value;
 }
 
 }  // namespace

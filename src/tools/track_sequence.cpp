@@ -76,6 +76,13 @@ struct Options {
   kct::TrackQualityParams quality;  ///< --quality NAME=VALUE, as the nodelet's parameters
 };
 
+/// NAME=VALUE split at the first '=' (--param, --quality).
+std::pair<std::string, std::string> name_value(const std::string& kv) {
+  const auto eq = kv.find('=');
+  if (eq == std::string::npos) throw std::invalid_argument("takes NAME=VALUE");
+  return {kv.substr(0, eq), kv.substr(eq + 1)};
+}
+
 Options parse(int argc, char** argv) {
   Options o;
   using kct_tools::store;
@@ -96,15 +103,10 @@ Options parse(int argc, char** argv) {
          {"--debug-dir", store(o.debug_dir)},
          {"--debug-every", store(o.debug_every)},
          {"--trace", store(o.trace)},
-         {"--param", [&o](const std::string& kv) {
-            const auto eq = kv.find('=');
-            if (eq == std::string::npos) throw std::invalid_argument("takes NAME=VALUE");
-            o.overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
-          }},
+         {"--param", [&o](const std::string& kv) { o.overrides.push_back(name_value(kv)); }},
          {"--quality", [&o](const std::string& kv) {
-            const auto eq = kv.find('=');
-            if (eq == std::string::npos) throw std::invalid_argument("takes NAME=VALUE");
-            kct::set_quality_param(o.quality, kv.substr(0, eq), kv.substr(eq + 1));
+            const auto [name, value] = name_value(kv);
+            kct::set_quality_param(o.quality, name, value);
             o.quality.validate();
           }}});
     if (!run) usage(nullptr);
