@@ -304,6 +304,25 @@ class Runner:
         self.repo, self.results, self.reuse = repo, results, set(reuse)
         self.track_sequence = list(track_sequence)
 
+    @staticmethod
+    def expected_frames(folder, max_frames):
+        """Frames track_sequence tracks in `folder` (its images, as sequence_io reads them)."""
+        n = len([f for f in os.listdir(folder)
+                 if os.path.splitext(f)[1].lower() in (".png", ".jpg", ".jpeg", ".bmp")])
+        return min(n, max_frames) if max_frames else n
+
+    def reusable(self, json_path, folder, max_frames, label, name):
+        """A reused result counts only when it tracked the frames this run would: a result from
+        an earlier frame cap (e.g. `paper` on 40 frames before 040f88b) is tracked again."""
+        with open(json_path) as f:
+            frames = json.load(f).get("frames")
+        want = self.expected_frames(folder, max_frames)
+        if frames == want:
+            return True
+        log("--reuse %s %s: the stored result tracked %s frames, this run tracks %d: tracking again"
+            % (label, name, frames, want))
+        return False
+
     def track(self, section, config, name, folder, model, max_frames=None, model_scale=None, score_model=None):
         label, preset, params = config
         out = os.path.join(self.results, section, label)
@@ -326,7 +345,8 @@ class Runner:
         if max_frames:
             cmd += ["--max-frames", str(max_frames)]
         t0 = time.time()
-        if label in self.reuse and os.path.exists(base + ".json"):
+        if label in self.reuse and os.path.exists(base + ".json") and \
+                self.reusable(base + ".json", folder, max_frames, label, name):
             pass  # --reuse: the previous run's result of this configuration
         else:
             for f in (base + ".json", base + ".errors.txt", base + ".trace.csv"):
