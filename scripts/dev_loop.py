@@ -8,7 +8,8 @@ generates them, or `dev_loop.py generate` under the built workspace's environmen
 
   dev_loop.py generate                                   # the hard sets and their noise draws
   dev_loop.py run LABEL [--binary PATH] [--draws 0,1] [--sets hard] [--objects can,toy]
-                  [--conditions occlusion] [--preset realtime] [--jobs 2] [--param NAME=VALUE ...]
+                  [--conditions occlusion] [--preset realtime] [--jobs 2] [--mismatch]
+                  [--param NAME=VALUE ...]
   dev_loop.py compare CANDIDATE BASE                      # paired per draw, per condition, runs
 
 Runs are written under $KCT_DATA/benchmark/dev/LABEL/ (poses, errors, trace, summary per run)
@@ -49,12 +50,20 @@ def run(a):
     jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in a.sets.split(",")
             for o in a.objects.split(",") for c in a.conditions.split(",")]
 
+    if a.mismatch:  # written once, before the threads read them
+        for o in a.objects.split(","):
+            B.mismatched_model(DATA, B.HARD_OBJECTS[o]["model"])
+
     def one(job):
         d, s, o, c = job
         source = os.path.join(DATA, s, o, c)
         folder = B.perturbed_sequence(DATA, source, s, o, c, d)
+        model = os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj")
+        # --mismatch: the benchmark's mismatch section's model (3 % off the object), scored
+        # against the true shape.
         r = runner.track("dev", (a.label, a.preset, params), "%s/%s/%s/d%d" % (s, o, c, d), folder,
-                         os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj"))
+                         B.mismatched_model(DATA, B.HARD_OBJECTS[o]["model"]) if a.mismatch else model,
+                         score_model=model if a.mismatch else None)
         if not r:  # Runner logged the failure
             return None
         B.score_visible(r, source)
@@ -124,6 +133,8 @@ def main():
     r.add_argument("--objects", default=",".join(B.HARD_OBJECTS))
     r.add_argument("--conditions", default=",".join(B.HARD_CONDITIONS))
     r.add_argument("--preset", default="realtime")
+    r.add_argument("--mismatch", action="store_true",
+                   help="track with the model 3 %% off the object (the mismatch section's), scored against the true one")
     r.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     r.add_argument("--param", action="append", default=[], dest="params", metavar="NAME=VALUE",
                    help="a track_sequence --param override (repeat for several)")
