@@ -72,7 +72,8 @@ def run(a):
                     visible_errors=r["visible_errors"])
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
         rows = [r for r in ex.map(one, jobs) if r]
-    json.dump(dict(label=a.label, binary=a.binary, preset=a.preset, params=a.params, rows=rows),
+    json.dump(dict(label=a.label, binary=a.binary, preset=a.preset, params=a.params, mismatch=a.mismatch,
+                   rows=rows),
               open(os.path.join(DEV, a.label + ".json"), "w"))
     for d in sorted({r["draw"] for r in rows}):
         print("draw %d: AUC %.2f" % (d, B.weighted_auc([r for r in rows if r["draw"] == d])))
@@ -91,7 +92,11 @@ def reacquisitions(rows):
 
 
 def compare(a):
-    load = lambda label: json.load(open(os.path.join(DEV, label + ".json")))["rows"]
+    runs = {label: json.load(open(os.path.join(DEV, label + ".json"))) for label in (a.candidate, a.base)}
+    if runs[a.candidate].get("mismatch", False) != runs[a.base].get("mismatch", False):
+        print("%s and %s differ in --mismatch: not comparable" % (a.candidate, a.base), file=sys.stderr)
+        return 1
+    load = lambda label: runs[label]["rows"]
     key = lambda r: (r["set"], r["object"], r["condition"], r["draw"])
     base = {key(r): r for r in load(a.base)}
     cand = [r for r in load(a.candidate) if key(r) in base]
