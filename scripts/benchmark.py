@@ -295,6 +295,14 @@ def available_presets():
     return ["paper", "klt_only"]
 
 
+def sequence_frames(folder, max_frames=None):
+    """Frames the tools track in the sequence `folder`: its images, as sequence_io reads them
+    (png, jpg, jpeg, bmp), at most max_frames."""
+    n = len([f for f in os.listdir(folder)
+             if os.path.splitext(f)[1].lower() in (".png", ".jpg", ".jpeg", ".bmp")])
+    return min(n, max_frames) if max_frames else n
+
+
 class Runner:
     """Tracks a sequence with a configuration and returns the summary JSON (plus the per-frame
     errors), or None when track_sequence failed."""
@@ -304,19 +312,12 @@ class Runner:
         self.repo, self.results, self.reuse = repo, results, set(reuse)
         self.track_sequence = list(track_sequence)
 
-    @staticmethod
-    def expected_frames(folder, max_frames):
-        """Frames track_sequence tracks in `folder` (its images, as sequence_io reads them)."""
-        n = len([f for f in os.listdir(folder)
-                 if os.path.splitext(f)[1].lower() in (".png", ".jpg", ".jpeg", ".bmp")])
-        return min(n, max_frames) if max_frames else n
-
     def reusable(self, json_path, folder, max_frames, label, name):
         """A reused result counts only when it tracked the frames this run would: a result from
         an earlier frame cap (e.g. `paper` on 40 frames before 040f88b) is tracked again."""
         with open(json_path) as f:
             frames = json.load(f).get("frames")
-        want = self.expected_frames(folder, max_frames)
+        want = sequence_frames(folder, max_frames)
         if frames == want:
             return True
         log("--reuse %s %s: the stored result tracked %s frames, this run tracks %d: tracking again"
@@ -1133,7 +1134,7 @@ def run_real(args, configs, runner, data, docs_dir, tmp):
         # References: the initial pose held still (what "no tracking" scores) and, with ground
         # truth, the true poses.
         pose_lines = [l for l in open(os.path.join(folder, "pose.txt")) if l.strip() and not l.startswith("#")]
-        frames = len([f for f in os.listdir(folder) if f.endswith(".png")])
+        frames = sequence_frames(folder)
         frozen = os.path.join(tmp, "%s_frozen.txt" % n)
         with open(frozen, "w") as f:
             f.write(pose_lines[0] * frames)

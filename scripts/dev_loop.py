@@ -50,20 +50,20 @@ def run(a):
     jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in a.sets.split(",")
             for o in a.objects.split(",") for c in a.conditions.split(",")]
 
-    if a.mismatch:  # written once, before the threads read them
-        for o in a.objects.split(","):
-            B.mismatched_model(DATA, B.HARD_OBJECTS[o]["model"])
+    # Per object: the model tracked and the one scored against (None: the same). --mismatch: the
+    # mismatch section's model (3 % off the object), written once before the threads read it.
+    models = {}
+    for o in a.objects.split(","):
+        true_model = os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj")
+        models[o] = ((B.mismatched_model(DATA, B.HARD_OBJECTS[o]["model"]), true_model) if a.mismatch
+                     else (true_model, None))
 
     def one(job):
         d, s, o, c = job
         source = os.path.join(DATA, s, o, c)
         folder = B.perturbed_sequence(DATA, source, s, o, c, d)
-        model = os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj")
-        # --mismatch: the benchmark's mismatch section's model (3 % off the object), scored
-        # against the true shape.
         r = runner.track("dev", (a.label, a.preset, params), "%s/%s/%s/d%d" % (s, o, c, d), folder,
-                         B.mismatched_model(DATA, B.HARD_OBJECTS[o]["model"]) if a.mismatch else model,
-                         score_model=model if a.mismatch else None)
+                         models[o][0], score_model=models[o][1])
         if not r:  # Runner logged the failure
             return None
         B.score_visible(r, source)
