@@ -65,6 +65,7 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_texture_shift", "realtime", {"texture_shift_search_below": "0"}),
     # ... nor turned and shifted to where they agree (the local alignment)
     ("realtime_no_texture_align", "realtime", {"texture_align_below": "0"}),
+    ("realtime_no_surface_hold", "realtime", {"surface_hold_correlation": "0"}),
     # a KLT failure whose refined pose lost the colours waits for the declared loss to be searched
     ("realtime_no_extrapolated_search", "realtime", {"extrapolated_search_ratio": "0"}),
     # ... and its find taken only above color_accept_ratio (not also when it beats the held pose)

@@ -112,6 +112,17 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
       last_quality_ = std::min(last_quality_, params_.min_quality * 0.5);
     }
   }
+  // A held frame (rule.surface_hold_correlation): the surface says the pose is right while the
+  // energy and the keypoints say it is not; the counters and the levels stay as they are.
+  const bool tracked = result.status == TrackStatus::kKeypoints ||
+                       result.status == TrackStatus::kExtrapolated;
+  if (!last_good_ && state_ == TrackState::kTracking && tracked &&
+      rule.surface_hold_correlation > 0.0 &&
+      color.surface_correlation >= rule.surface_hold_correlation) {
+    last_held_ = true;
+    return state_;
+  }
+  last_held_ = false;
   if (last_good_) {
     if (color.valid && color.visible_fraction >= 0.3 && std::isfinite(color.contrast)) {
       const double a = params_.energy_level_smoothing;
@@ -146,6 +157,7 @@ void TrackQualityMonitor::on_initialized(const Pose& object_to_camera) {
   color_level_ = 0.0;
   has_color_level_ = false;
   bad_frames_ = good_frames_ = 0;
+  last_held_ = false;
 }
 
 void TrackQualityMonitor::reset() {
@@ -156,6 +168,7 @@ void TrackQualityMonitor::reset() {
   color_level_ = 0.0;
   has_color_level_ = false;
   last_good_ = false;
+  last_held_ = false;
 }
 
 }  // namespace kct

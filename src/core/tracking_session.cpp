@@ -637,6 +637,11 @@ SessionResult TrackingSession::track(const Frame& frame) {
   rule.vanished_ratio = params_.color_vanished_ratio;
   rule.recover_ratio = params_.color_recover_ratio;
   rule.recover_min_visible = params_.color_recover_min_visible;
+  rule.surface_hold_correlation = params_.surface_hold_correlation;
+  // Only a colour pattern's correlation says where the surface is (a grey object's "pattern" is
+  // its shading, which a wrong pose of the castle matched at >= 0.7: hard2/castle/leave -5.5).
+  if (texture_ && texture_->has_color_pattern())
+    result.color.surface_correlation = result.texture_correlation;
   result.state = monitor_.update(result.frame, result.color, rule);
   if (params_.drop_unconfirmed_anchors && result.frame.status == TrackStatus::kExtrapolated &&
       !monitor_.last_good())

@@ -276,6 +276,52 @@ TEST(TrackQuality, LostAfterTheStatedBadFramesAndRecoversAfterTheStatedGoodFrame
   EXPECT_EQ(monitor.consecutive_bad_frames(), 0);
 }
 
+/// surface_hold_correlation: bad tracked frames whose surface colours still match are held
+/// (neither counted towards the loss nor learned from); below the bar, while lost, or with no
+/// surface score they count as before.
+TEST(TrackQuality, ASurfaceThatStillMatchesHoldsABadTrackedFrame) {
+  TrackQualityParams params;
+  params.lost_after_bad_frames = 3;
+  params.energy_level_smoothing = 1.0;  // level = the last good energy
+  ColorLossRule rule;
+  rule.surface_hold_correlation = 0.7;
+  ColorEvidence matching, differing, unscored;
+  matching.surface_correlation = 0.75;
+  differing.surface_correlation = 0.69;
+  const TrackResult good = refined_result(10.0, true, 0.9);
+  const TrackResult blurred = refined_result(2.0, true, 0.2);       // bad: 0.7 * 0.2 + 0.3 * 0.2
+  const TrackResult extrapolated = refined_result(2.0, false, 0.0);  // bad, KLT failed
+
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  monitor.update(good, {}, rule);
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_EQ(monitor.update(i % 2 ? blurred : extrapolated, matching, rule), TrackState::kTracking);
+    EXPECT_FALSE(monitor.last_good());
+    EXPECT_TRUE(monitor.last_held());
+  }
+  EXPECT_EQ(monitor.consecutive_bad_frames(), 0);
+  EXPECT_DOUBLE_EQ(monitor.energy_level(), 10.0);  // nothing learned from held frames
+  // Just below the bar, or without a surface score: bad frames, lost after 3.
+  EXPECT_EQ(monitor.update(blurred, differing, rule), TrackState::kTracking);
+  EXPECT_FALSE(monitor.last_held());
+  EXPECT_EQ(monitor.update(blurred, unscored, rule), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(blurred, differing, rule), TrackState::kLost);
+  // While lost a matching surface does not hold a frame (nor recover the track by itself).
+  EXPECT_EQ(monitor.update(blurred, matching, rule), TrackState::kLost);
+  EXPECT_FALSE(monitor.last_held());
+  EXPECT_EQ(monitor.consecutive_bad_frames(), 4);
+
+  // Off (0): the same frames are lost after 3.
+  TrackQualityMonitor off(params);
+  off.on_initialized(Pose::Identity());
+  off.update(good);
+  ColorLossRule none;
+  EXPECT_EQ(off.update(blurred, matching, none), TrackState::kTracking);
+  EXPECT_EQ(off.update(blurred, matching, none), TrackState::kTracking);
+  EXPECT_EQ(off.update(blurred, matching, none), TrackState::kLost);
+}
+
 TEST(TrackQuality, InvalidInputChangesNothingAndNotInitializedMeansWaiting) {
   TrackQualityParams params;
   params.lost_after_bad_frames = 1;

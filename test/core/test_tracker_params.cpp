@@ -44,6 +44,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_FALSE(p.texture_check_every_frame);
   EXPECT_DOUBLE_EQ(p.texture_shift_search_below, 0.0);
   EXPECT_DOUBLE_EQ(p.texture_align_below, 0.0);
+  EXPECT_DOUBLE_EQ(p.surface_hold_correlation, 0.0);
 }
 
 TEST(TrackerParams, CueFieldsAreValidated) {
@@ -120,7 +121,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 94u);
+  EXPECT_EQ(fields.size(), 95u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

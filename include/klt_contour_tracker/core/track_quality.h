@@ -6,6 +6,7 @@
 /// recent good frames, and the KLT RANSAC inlier ratio. The monitor only classifies results;
 /// the caller decides what to do (e.g. Tracker::reacquire() while lost).
 
+#include <limits>
 #include <string>
 
 #include "klt_contour_tracker/core/pose.h"
@@ -27,6 +28,10 @@ struct ColorEvidence {
   bool valid = false;             ///< false: no colour model or a grey frame (ignored)
   double contrast = 0.0;          ///< mean P(fg) inside the silhouette - in a ring around it
   double visible_fraction = 1.0;  ///< share of the silhouette inside the image
+  /// Correlation of the pose's surface colours with the learned ones (SurfaceTexture), NaN when
+  /// not scored or the object has no colour pattern. Used by ColorLossRule::surface_hold_correlation,
+  /// also when `valid` is false.
+  double surface_correlation = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// When colour evidence makes a frame bad (TrackingSession fills it from TrackerParams'
@@ -55,6 +60,10 @@ struct ColorLossRule {
   /// ... and at least this share of its silhouette is inside the image (0 = off): a pose mostly
   /// outside the image has too little outline and colour to be told from a distractor.
   double recover_min_visible = 0.0;
+  /// 0 = off. While TRACKING, a bad frame that KLT tracked or extrapolated whose
+  /// surface_correlation is at least this is held: neither counted towards the loss nor good
+  /// (blur lowers the contour energy and the keypoints while the printed surface still matches).
+  double surface_hold_correlation = 0.0;
 };
 
 /// Thresholds of the quality score and the state machine (all ours).
@@ -104,6 +113,8 @@ class TrackQualityMonitor {
   /// state. Returns the new state. With valid `color` evidence a frame is also bad when less
   /// than 10 % of the object is in the image or its contrast is below `rule.lost_ratio` x the
   /// running contrast level of good frames (`rule`: when the contour energy or KLT overrules that).
+  /// A bad tracked frame whose surface colours still match (`rule.surface_hold_correlation`) is
+  /// held: the state, the counters and the levels do not change.
   TrackState update(const TrackResult& result, const ColorEvidence& color = {},
                     const ColorLossRule& rule = {});
   /// Running colour contrast of good frames (0 when none yet).
@@ -125,6 +136,9 @@ class TrackQualityMonitor {
   double last_quality() const { return last_quality_; }
   /// Whether the last update() was a good frame.
   bool last_good() const { return last_good_; }
+  /// Whether the last update() was a bad frame held by ColorLossRule::surface_hold_correlation
+  /// (not counted towards the loss).
+  bool last_held() const { return last_held_; }
   /// Pose of the last good frame (or the last given pose), object_to_camera.
   const Pose& last_good_pose() const { return last_good_pose_; }
   /// Running contour-energy level of good refined frames (0 when none yet).
@@ -145,6 +159,7 @@ class TrackQualityMonitor {
   bool has_color_level_ = false;
   double last_quality_ = 0.0;
   bool last_good_ = false;
+  bool last_held_ = false;
   int bad_frames_ = 0;
   int good_frames_ = 0;
 };
