@@ -34,9 +34,9 @@ struct ColorEvidence {
   double surface_correlation = std::numeric_limits<double>::quiet_NaN();
 };
 
-/// When colour evidence makes a frame bad (TrackingSession fills it from TrackerParams'
-/// color_lost_ratio, color_contour_veto_ratio, color_keypoint_veto_inliers and
-/// color_vanished_ratio).
+/// When colour evidence makes a frame bad, or a bad frame is held (TrackingSession fills each
+/// field from the TrackerParams field of its name prefixed color_, e.g. color_lost_ratio, and
+/// surface_hold_correlation from the field of that name).
 struct ColorLossRule {
   /// A frame is faded (bad) when its contrast is below this x the running level (0 = never).
   double lost_ratio = 0.0;
