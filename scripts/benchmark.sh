@@ -2,13 +2,15 @@
 # Benchmark: installs and builds (like demo.sh), generates the missing models and sequences
 # under data/benchmark (cached, deterministic), tracks them with each configuration and writes
 # docs/benchmarks.md (+ docs/benchmarks/<section>.md and the success-curve PNGs).
-#   scripts/benchmark.sh [--section hard|hard2|mismatch|photo|noise|real|opt ...] [--quick] [--preset NAME ...]
+#   scripts/benchmark.sh [--section hard|hard2|mismatch|camera|photo|noise|real|opt ...] [--quick] [--preset NAME ...]
 #                        [--variant LABEL:PRESET:param=value,...] [--hard-frames N] [--reuse LABEL]
 #                        [--objects can,chest,...] [--frames N] [--track-frames N]
 #   sections (default: all): hard (hand-held, clutter, occlusion, leaving the image, lighting,
 #     sensor effects; 4 objects x 6 conditions x 80 frames), hard2 (the same with other seeds and
 #     backgrounds: a change is judged on both), mismatch (the hard frames tracked with each model
-#     stretched 3 % and scored against the true one: a biased contour, as on real video), photo (4 objects x 3 conditions of hard
+#     stretched 3 % and scored against the true one: a biased contour, as on real video), camera
+#     (the hard set's frames as a live 30 Hz camera: a frame a newer one replaced while the tracker
+#     was busy is dropped, as the nodelet's queue drops it; realtime, paper, klt_only), photo (4 objects x 3 conditions of hard
 #     trajectories path-traced by Blender's Cycles; rendering takes ~1 h the first time), noise (realtime, klt_only, paper (first 40 frames) and each --variant on
 #     both hard sets from 5 slightly perturbed initial poses: how much of a difference is
 #     chance), real (ViSP's sequences from
@@ -26,7 +28,7 @@ while [ $# -gt 0 ]; do
     --quick) ARGS+=(--quick); shift ;;
     --preset) [ $# -ge 2 ] || { echo "benchmark: --preset needs a name" >&2; exit 2; }
               ARGS+=(--preset "$2"); shift 2 ;;
-    --section) [ $# -ge 2 ] || { echo "benchmark: --section needs hard, hard2, mismatch, photo, noise, real or opt" >&2; exit 2; }
+    --section) [ $# -ge 2 ] || { echo "benchmark: --section needs hard, hard2, mismatch, camera, photo, noise, real or opt" >&2; exit 2; }
                ARGS+=(--section "$2"); shift 2 ;;
     --variant) [ $# -ge 2 ] || { echo "benchmark: --variant needs LABEL:PRESET:param=value,..." >&2; exit 2; }
                ARGS+=(--variant "$2"); shift 2 ;;
@@ -40,7 +42,7 @@ while [ $# -gt 0 ]; do
               ARGS+=(--frames "$2"); shift 2 ;;
     --track-frames) [ $# -ge 2 ] || { echo "benchmark: --track-frames needs a number" >&2; exit 2; }
               ARGS+=(--track-frames "$2"); shift 2 ;;
-    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     *) echo "benchmark: unknown argument $1" >&2; exit 2 ;;
   esac
 done

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -40,6 +41,8 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
   if (sequence.poses.empty())
     throw std::runtime_error("the sequence has no pose.txt; its first line is the initial pose");
   if (sequence.image_paths.empty()) throw std::runtime_error("the sequence has no images");
+  if (!(options.camera_rate_hz >= 0.0) || !std::isfinite(options.camera_rate_hz))
+    throw std::invalid_argument("camera_rate_hz must be finite and >= 0 (0: every frame)");
   std::size_t frames = sequence.image_paths.size();
   if (options.max_frames > 0) frames = std::min(frames, options.max_frames);
 
@@ -56,7 +59,19 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
   run.startup_ms = elapsed_ms(startup);
   session.initialize(sequence.poses.front());
   Pose last = sequence.poses.front();
+  run.dropped.assign(frames, 0);
+  // camera_rate_hz: when the session is next free, s (frame 0 arrives at 0).
+  double free_at_s = 0.0;
+  const auto arrival_s = [&](std::size_t i) { return static_cast<double>(i) / options.camera_rate_hz; };
   for (std::size_t i = 0; i < frames; ++i) {
+    if (options.camera_rate_hz > 0.0 && i > 0 && i + 1 < frames && arrival_s(i + 1) <= free_at_s) {
+      // A newer frame is waiting when the session frees: this one was replaced in the queue.
+      run.dropped[i] = 1;
+      ++run.dropped_frames;
+      run.object_to_camera.push_back(last);
+      continue;
+    }
+    double busy_ms = 0.0;  // the session's time on this frame (decoding is the camera's)
     const std::string& path = sequence.image_paths[i];
     std::string error = check_frame_file(path, size, options.max_image_pixels);
     cv::Mat image;
@@ -66,7 +81,9 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
     }
     SessionResult result;
     if (error.empty()) {
+      const auto started = std::chrono::steady_clock::now();
       result = session.track({image, static_cast<double>(i)});
+      busy_ms = elapsed_ms(started);
       if (result.frame.status == TrackStatus::kInvalidInput) error = path + ": " + result.frame.message;
     } else {
       result.frame.status = TrackStatus::kInvalidInput;
@@ -82,6 +99,8 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
       if (i > 0) run.frame_ms.push_back(result.frame.frame_time_ms);
       if (result.frame.status == TrackStatus::kExtrapolated) ++run.extrapolated;
     }
+    if (options.camera_rate_hz > 0.0)
+      free_at_s = std::max(free_at_s, arrival_s(i)) + busy_ms / 1000.0;
     run.object_to_camera.push_back(last);
     if (options.on_frame) options.on_frame(i, image, result, session);
   }

@@ -5,7 +5,7 @@
 //   track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]
 //                  [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]
 //                  [--max-frames N] [--max-image-pixels N] [--errors FILE] [--score-model MESH]
-//                  [--debug-dir DIR [--debug-every N]] [--quiet]
+//                  [--debug-dir DIR [--debug-every N]] [--camera-rate HZ] [--quiet]
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -35,7 +35,8 @@ void usage(const char* error) {
                "                      [--output FILE] [--summary-json FILE]\n"
                "                      [--max-frames N] [--max-image-pixels N] [--errors FILE]\n"
                "                      [--score-model MESH]\n"
-               "                      [--debug-dir DIR [--debug-every N]] [--trace FILE] [--quiet]\n"
+               "                      [--debug-dir DIR [--debug-every N]] [--trace FILE]\n"
+               "                      [--camera-rate HZ] [--quiet]\n"
                "  --quality NAME=VALUE: the session's loss / recovery thresholds, as the nodelet's\n"
                "  parameters of the same names (lost_after_bad_frames, recover_after_good_frames,\n"
                "  min_quality, energy_weight, energy_level_smoothing, reacquire_search_scale).\n"
@@ -55,6 +56,10 @@ void usage(const char* error) {
                "  --trace FILE writes one CSV line per frame: status, state, quality, KLT tracked / inliers,\n"
                "  energy before / after / level, colour contrast / level, searched, colour visible fraction,\n"
                "  relocalized, rotation corrected (why a track was lost or kept).\n"
+               "  --camera-rate HZ: replay as a live camera at HZ: a frame that a newer one replaced\n"
+               "  while the tracker was busy (its wall time here) is dropped, as the nodelet's one-message\n"
+               "  queue drops it, and holds the last pose (scored so; no trace or debug line). Timing-\n"
+               "  dependent: the score depends on this machine and its load. [0 = every frame]\n"
                "  DIR holds images (sorted by name), K.txt and pose.txt (first line = initial pose;\n"
                "  the rest, when present, is the ground truth used for scoring; with the initial pose alone\n"
                "  the run is not scored and --errors fails).\n"
@@ -71,6 +76,7 @@ struct Options {
   double model_scale = 1.0;
   int max_frames = -1;
   long long max_image_pixels = 4096LL * 4096;
+  double camera_rate_hz = 0.0;  ///< --camera-rate; 0 = every frame
   bool quiet = false;
   std::vector<std::pair<std::string, std::string>> overrides;
   kct::TrackQualityParams quality;  ///< --quality NAME=VALUE, as the nodelet's parameters
@@ -103,6 +109,7 @@ Options parse(int argc, char** argv) {
          {"--debug-dir", store(o.debug_dir)},
          {"--debug-every", store(o.debug_every)},
          {"--trace", store(o.trace)},
+         {"--camera-rate", store(o.camera_rate_hz)},
          {"--param", [&o](const std::string& kv) { o.overrides.push_back(name_value(kv)); }},
          {"--quality", [&o](const std::string& kv) {
             const auto [name, value] = name_value(kv);
@@ -114,6 +121,8 @@ Options parse(int argc, char** argv) {
     usage(e.what());
   }
   o.debug_every = std::max(1, o.debug_every);
+  if (!(o.camera_rate_hz >= 0.0 && o.camera_rate_hz < 1e9))
+    usage("--camera-rate takes a rate in Hz >= 0 (0: every frame)");
   if (o.sequence.empty() || o.model.empty()) usage("--sequence and --model are required");
   return o;
 }
@@ -176,6 +185,7 @@ int main(int argc, char** argv) {
     run_options.max_frames = options.max_frames > 0 ? static_cast<size_t>(options.max_frames) : 0;
     run_options.max_image_pixels = options.max_image_pixels;
     run_options.quality = options.quality;
+    run_options.camera_rate_hz = options.camera_rate_hz;
     size_t frames = sequence.image_paths.size();
     if (options.max_frames > 0) frames = std::min(frames, static_cast<size_t>(options.max_frames));
     // Per-stage times of the tracked frames (not the first), for the benchmark's stage table.
@@ -248,6 +258,8 @@ int main(int argc, char** argv) {
          << ",\n  \"faces\": " << mesh->faces.size() << ",\n  \"vertices\": " << mesh->vertices.size()
          << ",\n  \"width\": " << run.camera.width() << ",\n  \"height\": " << run.camera.height()
          << ",\n  \"extrapolated_frames\": " << run.extrapolated
+         << ",\n  \"camera_rate_hz\": " << options.camera_rate_hz
+         << ",\n  \"dropped_frames\": " << run.dropped_frames
          << ",\n  \"invalid_frames\": " << stats.invalid_frames
          << ",\n  \"frames_lost\": " << stats.frames_lost << ",\n  \"losses\": " << stats.losses
          << ",\n  \"reacquisitions\": " << stats.reacquisitions
@@ -261,6 +273,8 @@ int main(int argc, char** argv) {
     std::printf("frames            %zu\n", frames);
     std::printf("invalid_frames    %d\n", stats.invalid_frames);
     std::printf("extrapolated      %d\n", run.extrapolated);
+    if (options.camera_rate_hz > 0.0)
+      std::printf("dropped_frames    %d  (at %.4g Hz)\n", run.dropped_frames, options.camera_rate_hz);
     std::printf("frames_lost       %d\n", stats.frames_lost);
     std::printf("losses            %d\n", stats.losses);
     std::printf("reacquisitions    %d  (frames from loss to re-acquired: %s)\n", stats.reacquisitions,

@@ -174,5 +174,48 @@ TEST_F(SequenceRunTest, OversizedAndUnreadableFramesGetAPerFrameErrorBeforeDecod
   }
 }
 
+TEST_F(SequenceRunTest, CameraRateDropsTheFramesANewerOneReplacedWhileTracking) {
+  const Mesh box = test::make_box(0.12, 0.08, 0.06);
+  const std::string folder = (dir_ / "live").string();
+  const std::vector<Pose> truth = write_frames(folder, box);
+  write_pose_file(folder + "/pose.txt", truth);
+  const SequenceFolder sequence = read_sequence(folder);
+  auto mesh = std::make_shared<Mesh>(box);
+  const TrackerParams params = make_preset("klt_only");
+  const SequenceRun every = track_sequence_folder(sequence, mesh, params);
+  EXPECT_EQ(every.dropped_frames, 0);
+
+  // A frame every 1000 s: the tracker is always free again before the next one arrives, so
+  // nothing is dropped and the poses are those of the every-frame run (klt_only is deterministic).
+  SequenceRunOptions slow;
+  slow.camera_rate_hz = 1e-3;
+  const SequenceRun slow_run = track_sequence_folder(sequence, mesh, params, slow);
+  EXPECT_EQ(slow_run.dropped_frames, 0);
+  ASSERT_EQ(slow_run.object_to_camera.size(), 12u);
+  for (std::size_t i = 0; i < 12; ++i)
+    EXPECT_LT(translation_error(slow_run.object_to_camera[i], every.object_to_camera[i]), 1e-12) << i;
+
+  // A million frames a second: all 12 arrive within 11 us, while the first frame (keypoint
+  // detection) is being tracked. The queue then holds only the newest, the last: frames 1-10
+  // are dropped and hold the first frame's pose, the last one is tracked.
+  SequenceRunOptions fast;
+  fast.camera_rate_hz = 1e6;
+  const SequenceRun fast_run = track_sequence_folder(sequence, mesh, params, fast);
+  ASSERT_EQ(fast_run.object_to_camera.size(), 12u);
+  ASSERT_EQ(fast_run.dropped.size(), 12u);
+  EXPECT_EQ(fast_run.dropped_frames, 10);
+  EXPECT_EQ(fast_run.dropped.front(), 0);
+  EXPECT_EQ(fast_run.dropped.back(), 0);
+  for (std::size_t i = 1; i + 1 < 12; ++i) {
+    EXPECT_EQ(fast_run.dropped[i], 1) << i;
+    EXPECT_LT(translation_error(fast_run.object_to_camera[i], fast_run.object_to_camera[0]), 1e-12) << i;
+  }
+  EXPECT_EQ(fast_run.frame_ms.size(), 1u);  // the last frame's: the first is the initial pose
+
+  SequenceRunOptions bad;
+  bad.camera_rate_hz = -30.0;
+  EXPECT_THROW(track_sequence_folder(sequence, mesh, params, bad), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace kct

@@ -28,6 +28,13 @@ struct SequenceRunOptions {
   /// = 48 MB decoded as BGR.
   std::int64_t max_image_pixels = std::int64_t{4096} * 4096;
   TrackQualityParams quality;  ///< loss detection / re-acquisition thresholds
+  /// > 0: a live camera at this rate, Hz. Frame i arrives at i / camera_rate_hz s; the session
+  /// takes each frame as long as its track() call takes here (wall time), and a frame that a
+  /// newer one has replaced by the time the session is free is dropped, as a live stream with a
+  /// one-message queue drops it (the nodelet's default ~queue_size 1). A dropped frame keeps the
+  /// last pose (what the robot holds then) and is not passed to on_frame. 0: every frame is
+  /// tracked, however long it takes (a bag played paced on the tracker).
+  double camera_rate_hz = 0.0;
   /// Called after every frame: its index, the decoded image (empty when the frame could not be
   /// read), the session's result and the session.
   std::function<void(std::size_t, const cv::Mat&, const SessionResult&, const TrackingSession&)> on_frame;
@@ -41,6 +48,9 @@ struct SequenceRun {
   std::vector<double> frame_ms;           ///< Tracker time of each frame after the first
   std::vector<std::string> frame_errors;  ///< "file: reason" of each frame that could not be used
   int extrapolated = 0;                   ///< frames whose preliminary pose was extrapolated
+  /// camera_rate_hz: per frame, 1 when it was dropped (never tracked; it holds the last pose).
+  std::vector<char> dropped;
+  int dropped_frames = 0;                 ///< frames dropped at camera_rate_hz
   SessionStatistics statistics;           ///< losses, re-acquisitions... of the session
   /// Wall time of the session's start (its tracker and visibility table: built, or read from
   /// the cache), ms; what a nodelet spends before its first frame.
