@@ -374,8 +374,17 @@ class Runner:
         if os.path.exists(base + ".trace.csv"):
             with open(base + ".trace.csv") as f:
                 trace = list(csv.DictReader(f))
-            summary["good"] = [row["good"] == "1" for row in trace]
-            summary["states"] = [row["state"] for row in trace]
+            # One verdict per frame: a frame dropped at --camera-rate has no trace line and keeps
+            # the last tracked frame's verdict, as it keeps its pose.
+            by_frame = {int(row["frame"]): row for row in trace}
+            frames = max(summary.get("frames", 0), max(by_frame, default=-1) + 1)
+            rows, last_row = [], None
+            for i in range(frames):
+                last_row = by_frame.get(i, last_row)
+                if last_row is not None:
+                    rows.append(last_row)
+            summary["good"] = [row["good"] == "1" for row in rows]
+            summary["states"] = [row["state"] for row in rows]
         summary.update(preset=label, wall_s=time.time() - t0, poses_file=base + ".poses.txt")
         return summary
 

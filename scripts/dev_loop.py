@@ -9,7 +9,7 @@ generates them, or `dev_loop.py generate` under the built workspace's environmen
   dev_loop.py generate                                   # the hard sets and their noise draws
   dev_loop.py run LABEL [--binary PATH] [--draws 0,1] [--sets hard] [--objects can,toy]
                   [--conditions occlusion] [--preset realtime] [--jobs 2] [--mismatch]
-                  [--param NAME=VALUE ...]
+                  [--param NAME=VALUE ...] [--camera-rate 30]
   dev_loop.py compare CANDIDATE BASE                      # paired per draw, per condition, runs
 
 Runs are written under $KCT_DATA/benchmark/dev/LABEL/ (poses, errors, trace, summary per run)
@@ -45,7 +45,10 @@ def generate(_):
 
 def run(a):
     # benchmark.py's Runner with this binary: its runs under DATA/dev/LABEL/.
-    runner = B.Runner(ROOT, DATA, track_sequence=[a.binary])
+    # --camera-rate: as a live camera (track_sequence --camera-rate; timing-dependent: use
+    # --jobs 1 on an otherwise idle machine, and compare against a base run the same way).
+    runner = B.Runner(ROOT, DATA, track_sequence=[a.binary] + (
+        ["--camera-rate", "%g" % a.camera_rate] if a.camera_rate > 0 else []))
     params = dict(kv.split("=", 1) for kv in a.params)
     jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in a.sets.split(",")
             for o in a.objects.split(",") for c in a.conditions.split(",")]
@@ -141,6 +144,8 @@ def main():
     r.add_argument("--mismatch", action="store_true",
                    help="track with the model 3 %% off the object (the mismatch section's), scored against the true one")
     r.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    r.add_argument("--camera-rate", type=float, default=0.0, metavar="HZ",
+                   help="replay as a live camera at HZ (frames dropped while busy); 0: every frame")
     r.add_argument("--param", action="append", default=[], dest="params", metavar="NAME=VALUE",
                    help="a track_sequence --param override (repeat for several)")
     c = sub.add_parser("compare")
