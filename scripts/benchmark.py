@@ -712,10 +712,11 @@ def run_camera(args, configs, runner, data, docs_dir, tmp):
                          runner.track_sequence + ["--camera-rate", "%g" % CAMERA_RATE_HZ])
     rows = []
     for config in configs:
-        for mode, r_runner in (("every frame", runner), ("30 Hz", live_runner)):
+        # mode, its runner, the results folder its runs go to
+        for mode, r_runner, section in (("every frame", runner, "camera"),
+                                        ("30 Hz", live_runner, "camera_live")):
             for (o, c), folder in folders.items():
                 model = os.path.join(data, "models", HARD_OBJECTS[o]["model"] + ".obj")
-                section = "camera" if r_runner is runner else "camera_live"
                 r = r_runner.track(section, config, "%s/%s" % (o, c), folder, model)
                 if not r:
                     continue
@@ -757,10 +758,11 @@ def run_camera(args, configs, runner, data, docs_dir, tmp):
              "sequences), ms.\n" % CAMERA_RATE_HZ)
     L.append("| preset | " + " | ".join(conditions) + " | **all** | median ms | p90 ms |")
     L.append("|---|" + "---|" * (len(conditions) + 3))
+
+    def dropped(rr):
+        total = sum(r.get("frames", 0) for r in rr)
+        return "%.0f %%" % (100.0 * sum(r.get("dropped_frames", 0) for r in rr) / total) if total else "-"
     for c in configs:
-        def dropped(rr):
-            total = sum(r.get("frames", 0) for r in rr)
-            return "%.0f %%" % (100.0 * sum(r.get("dropped_frames", 0) for r in rr) / total) if total else "-"
         every = sel(preset=c[0], mode="every frame")
         L.append("| %s | %s | **%s** | %s | %s |" % (
             c[0], " | ".join(dropped(sel(preset=c[0], mode="30 Hz", condition=k)) for k in conditions),
