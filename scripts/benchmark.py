@@ -82,12 +82,14 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_corner_fallback", "realtime", {"corner_fallback_below": "0"}),
     # keypoints anchored after a KLT failure kept even when the frame is judged bad
     ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
+    # ORB keyframes matched while lost (feature_relocalizer.h) off: the colour search alone
+    ("realtime_no_feature_relocalization", "realtime", {"feature_relocalization": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     # the PnP pose made the most likely pose under a prior on the frame-to-frame motion
     ("realtime_keypoint_prior", "realtime", {"keypoint_prior_diameters": "0.1"}),
-    # ORB keyframes: tracking by detection for textured objects (feature_relocalizer.h)
-    ("realtime_feature_relocalization", "realtime", {"feature_relocalization": "true"}),
+    # ... matched on every tracked frame as well, replacing a track in doubt they contradict
+    ("realtime_relocalization_while_tracking", "realtime", {"relocalization_while_tracking": "true"}),
     ("realtime_motion_model", "realtime",
      {"motion_model": "true", "motion_prior_weight": "1", "keypoint_motion_gate_sigmas": "3"}),
 ]

@@ -278,6 +278,18 @@ bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, Sessio
   if (relocalizer_->keyframes() == 0) return false;
   const Relocalization found = relocalizer_->locate(gray, tracker_->camera());
   if (!found.found) return false;
+  // As the colour search's hypotheses: not farther than the object could have gone
+  // (color_search_reach_diameters; a clutter thing wearing the object's texture matches too).
+  const double reach_px = search_reach_px();
+  if (reach_px > 0.0) {
+    const Eigen::Vector3d& center = tracker_->center_object();
+    const PinholeCamera& camera = tracker_->camera();
+    const Eigen::Vector3d found_center = found.object_to_camera * center;
+    const Eigen::Vector3d last_good_center = monitor_.last_good_pose() * center;
+    if (!(found_center.z() > 0.0 && last_good_center.z() > 0.0) ||
+        (camera.project(found_center) - camera.project(last_good_center)).norm() > reach_px)
+      return false;
+  }
   adopt_relocalized(frame, found.object_to_camera, result);
   return true;
 }
@@ -607,15 +619,20 @@ SessionResult TrackingSession::track(const Frame& frame) {
   if (search_ && frame.image.type() == CV_8UC3 && frame.image.size() == tracker_->camera().size() &&
       !ObjectSearch::looks_grey(frame.image))
     bgr = tracker_->undistorted_color(frame.image);
-  // The feature relocalizer's frame (undistorted grey), when it is on and the frame is usable.
+  // The feature relocalizer's frame (undistorted grey), when it is on, the frame is usable and
+  // features are matched on it (while lost, or on every frame with
+  // relocalization_while_tracking; the given pose's keyframe takes it below).
+  const auto features_frame = [&]() {
+    return relocalizer_ && tracker_->check_frame(frame).empty() ? tracker_->undistorted_gray(frame.image)
+                                                                : cv::Mat();
+  };
   cv::Mat gray;
-  if (relocalizer_ && tracker_->check_frame(frame).empty())
-    gray = tracker_->undistorted_gray(frame.image);
+  if (result.reacquiring || params_.relocalization_while_tracking) gray = features_frame();
   features_confirm_ = false;
   if (!(result.reacquiring && !gray.empty() && relocalize(frame, gray, result))) {
     result.frame =
         result.reacquiring ? reacquire(frame, bgr, result.searched) : tracker_->track(frame);
-    if (!gray.empty()) use_features(frame, gray, result);
+    if (!gray.empty() && params_.relocalization_while_tracking) use_features(frame, gray, result);
     if (result.frame.status == TrackStatus::kExtrapolated)
       search_if_faded(frame, bgr, result, params_.extrapolated_search_ratio, false);
     check_rotation(frame, bgr, result);  // only on tracked frames (kKeypoints, kExtrapolated)
@@ -646,6 +663,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   if (params_.drop_unconfirmed_anchors && result.frame.status == TrackStatus::kExtrapolated &&
       !monitor_.last_good())
     tracker_->forget_keypoints();
+  if (gray.empty() && result.frame.status == TrackStatus::kInitialized) gray = features_frame();
   if (!gray.empty()) add_keyframe_if_due(gray, result);
   // rotation_check's window: frames since KLT last failed or the track was re-acquired.
   const bool doubt = result.frame.status == TrackStatus::kExtrapolated ||

@@ -121,7 +121,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 95u);
+  EXPECT_EQ(fields.size(), 96u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -158,9 +158,12 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   bad = realtime;
   bad.relocalization_override_inliers = 3;  // fewer than PnP + a check need
   EXPECT_THROW(bad.validate(), std::invalid_argument);
-  // The feature relocalizer is off in every preset (measured even on the hard sets).
-  EXPECT_FALSE(realtime.feature_relocalization);
+  // The feature relocalizer is realtime's, and only while lost (it costs nothing while
+  // tracking); paper stays the paper's method.
+  EXPECT_TRUE(realtime.feature_relocalization);
+  EXPECT_FALSE(realtime.relocalization_while_tracking);
   EXPECT_FALSE(make_preset("paper").feature_relocalization);
+  EXPECT_FALSE(make_preset("klt_only").feature_relocalization);
   // The session's colour model and the PnP motion bounds are ours: off in paper and klt_only.
   EXPECT_TRUE(realtime.color_search);
   EXPECT_FALSE(make_preset("paper").color_search);

@@ -252,6 +252,7 @@ TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
   const Pose& start = scene.start;
   const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
   TrackerParams params = quick_realtime();
+  params.feature_relocalization = false;  // the colour search alone (its features find it too)
   for (const bool with_search : {false, true}) {
     params.color_search = with_search;
     TrackingSession session(mesh, params);
@@ -301,6 +302,7 @@ TEST(TrackingSession, AReachKeepsReacquisitionOffAFarTwin) {
     return frame;
   };
   TrackerParams params = quick_realtime();
+  params.feature_relocalization = false;  // the colour search's reach (the features': below)
   for (const double reach : {0.0, 0.05}) {
     params.color_search_reach_diameters = reach;
     TrackingSession session(scene.mesh, params);
@@ -458,15 +460,31 @@ TEST(TrackingSession, ATrackHeldOnTheBackgroundIsSearchedForBeforeTheLoss) {
 
 /// feature_relocalization: a textured box is hidden, then shown again 12 cm to the side and 8 deg
 /// turned (far outside the refinement's reach); with the colour search off, only the keyframe
-/// features of the initial pose can find it: re-acquired within 10 frames with, never without.
+/// features of the initial pose can find it: re-acquired within 10 frames with, never without,
+/// whether the features are matched on every frame or only while lost
+/// (relocalization_while_tracking); and not while it is farther than it could have gone
+/// (color_search_reach_diameters 0.01: 4 mm a frame, 2-4 cm over the frames here).
 TEST(TrackingSession, FeatureRelocalizationReacquiresATexturedObjectFarAway) {
   const Scene scene;
   const Pose start = test::make_pose(0.45);
   const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
   TrackerParams params = quick_realtime();
   params.color_search = false;
-  for (const bool with_features : {false, true}) {
-    params.feature_relocalization = with_features;
+  struct Mode {
+    bool features, while_tracking;
+    double reach_diameters;
+  };
+  const double reach = params.color_search_reach_diameters;
+  for (const Mode mode : {Mode{false, true, reach}, Mode{true, true, reach},
+                          Mode{true, false, reach}, Mode{true, false, 0.01}}) {
+    const bool with_features = mode.features && mode.reach_diameters > 0.05;
+    SCOPED_TRACE(!mode.features ? "off"
+                 : mode.reach_diameters <= 0.05 ? "out of reach"
+                 : mode.while_tracking          ? "every frame"
+                                                : "while lost");
+    params.feature_relocalization = mode.features;
+    params.relocalization_while_tracking = mode.while_tracking;
+    params.color_search_reach_diameters = mode.reach_diameters;
     TrackingSession session(scene.mesh, params);
     session.set_camera(scene.camera);
     session.initialize(start);
@@ -490,7 +508,7 @@ TEST(TrackingSession, FeatureRelocalizationReacquiresATexturedObjectFarAway) {
              rotation_error_deg(r.frame.object_to_camera, away) < 2.0;
     }
     EXPECT_EQ(back, with_features) << (with_features ? "not re-acquired within 10 frames"
-                                                     : "found without the features?");
+                                                     : "found without the features, or out of reach?");
     EXPECT_EQ(relocalized, with_features);
   }
 }
@@ -517,6 +535,7 @@ TEST(TrackingSession, WeakColourPlacementIsTakenWhenTwoFramesAgree) {
     return frame;
   };
   TrackerParams params = quick_realtime();
+  params.feature_relocalization = false;  // the colour search alone (its features find it too)
   ASSERT_GT(params.color_confirm_ratio, 0.0) << "realtime confirms weak placements";
   params.color_accept_ratio = 0.95;
   for (const double confirm : {0.0, params.color_confirm_ratio}) {
