@@ -225,15 +225,10 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     const std::vector<SearchCandidate> scored = search_->score(bgr, refined_poses, camera);
     // A hypothesis the refinement took out of reach is not a candidate (the last good pose,
     // the first, is the fallback).
-    const Eigen::Vector2d last_good_px = camera.project(last_good * center_object);
-    const auto in_reach = [&](const Pose& pose) {
-      const Eigen::Vector3d c = pose * center_object;
-      return reach_px <= 0.0 ||
-             (c.z() > 0.0 && (camera.project(c) - last_good_px).norm() <= reach_px);
-    };
     std::size_t best_index = 0;
     for (std::size_t i = 1; i < scored.size(); ++i)
-      if (scored[i].contrast > scored[best_index].contrast && in_reach(refined_poses[i]))
+      if (scored[i].contrast > scored[best_index].contrast &&
+          within_reach(refined_poses[i], reach_px))
         best_index = i;
     TrackResult best = refined[best_index];
     const double best_contrast = scored[best_index].contrast;
@@ -264,6 +259,16 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 
+bool TrackingSession::within_reach(const Pose& object_to_camera, double reach_px) const {
+  if (reach_px <= 0.0) return true;
+  const Eigen::Vector3d& center = tracker_->center_object();
+  const Eigen::Vector3d c = object_to_camera * center;
+  const PinholeCamera& camera = tracker_->camera();
+  // search_reach_px() is 0 when the last good pose's centre is not in front of the camera.
+  return c.z() > 0.0 &&
+         (camera.project(c) - camera.project(monitor_.last_good_pose() * center)).norm() <= reach_px;
+}
+
 double TrackingSession::search_reach_px() const {
   if (!(params_.color_search_reach_diameters > 0.0)) return 0.0;
   const Pose& last_good = monitor_.last_good_pose();
@@ -280,16 +285,7 @@ bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, Sessio
   if (!found.found) return false;
   // As the colour search's hypotheses: not farther than the object could have gone
   // (color_search_reach_diameters; a clutter thing wearing the object's texture matches too).
-  const double reach_px = search_reach_px();
-  if (reach_px > 0.0) {
-    const Eigen::Vector3d& center = tracker_->center_object();
-    const PinholeCamera& camera = tracker_->camera();
-    const Eigen::Vector3d found_center = found.object_to_camera * center;
-    const Eigen::Vector3d last_good_center = monitor_.last_good_pose() * center;
-    if (!(found_center.z() > 0.0 && last_good_center.z() > 0.0) ||
-        (camera.project(found_center) - camera.project(last_good_center)).norm() > reach_px)
-      return false;
-  }
+  if (!within_reach(found.object_to_camera, search_reach_px())) return false;
   adopt_relocalized(frame, found.object_to_camera, result);
   return true;
 }

@@ -150,8 +150,9 @@ struct TrackerParams {
   /// refined from the contour again and anchors afresh.
   bool drop_unconfirmed_anchors = false;
   /// ours (tracking session, feature_relocalizer.h): ORB features of keyframes (the initial
-  /// pose, then good frames from new viewpoints) anchored on the mesh; each frame they are
-  /// matched around the tracked pose, and a PnP pose from at least
+  /// pose, then good frames from new viewpoints) anchored on the mesh; with
+  /// relocalization_while_tracking each tracked frame they are matched around the tracked
+  /// pose, and a PnP pose from at least
   /// relocalization_override_inliers features that disagrees with a track in doubt (KLT failed
   /// or the last frame was bad) replaces it; while lost they are matched over the whole frame to
   /// re-acquire. Textured objects only (an

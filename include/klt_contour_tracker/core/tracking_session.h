@@ -138,6 +138,9 @@ class TrackingSession {
   /// color_search_reach_diameters: how far (full-resolution px) from the last good pose's
   /// projected centre the object can be on this frame; 0 = anywhere.
   double search_reach_px() const;
+  /// True when `object_to_camera`'s centre projects within `reach_px` (a search_reach_px()) of
+  /// the last good pose's; always when `reach_px` is 0.
+  bool within_reach(const Pose& object_to_camera, double reach_px) const;
   /// texture_shift_search_below, from texture_check (the held pose's colours `prepared`,
   /// correlating at `held_correlation`): true when a confirmed shift replaced the held pose.
   bool shift_by_texture(const Frame& frame, const cv::Mat& bgr, const PreparedFrame& prepared,
