@@ -93,7 +93,7 @@ int FeatureRelocalizer::add_keyframe(const cv::Mat& gray, const Pose& object_to_
 }
 
 cv::Rect FeatureRelocalizer::region_around(const Pose& object_to_camera, const PinholeCamera& camera,
-                                           double margin) const {
+                                           double margin, double grow_px) const {
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   for (const auto& corner : corners_object_) {
     const Eigen::Vector3d p = object_to_camera * corner;
@@ -104,7 +104,7 @@ cv::Rect FeatureRelocalizer::region_around(const Pose& object_to_camera, const P
     x1 = std::max(x1, uv.x());
     y1 = std::max(y1, uv.y());
   }
-  const double grow = margin * std::max(x1 - x0, y1 - y0);
+  const double grow = margin * std::max(x1 - x0, y1 - y0) + std::max(0.0, grow_px);
   const cv::Rect image(0, 0, camera.width(), camera.height());
   const double left = std::clamp(x0 - grow, -1.0, camera.width() + 1.0);
   const double top = std::clamp(y0 - grow, -1.0, camera.height() + 1.0);

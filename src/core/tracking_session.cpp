@@ -281,11 +281,20 @@ double TrackingSession::search_reach_px() const {
 
 bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
   if (relocalizer_->keyframes() == 0) return false;
-  const Relocalization found = relocalizer_->locate(gray, tracker_->camera());
-  if (!found.found) return false;
   // As the colour search's hypotheses: not farther than the object could have gone
   // (color_search_reach_diameters; a clutter thing wearing the object's texture matches too).
-  if (!within_reach(found.object_to_camera, search_reach_px())) return false;
+  // The features are detected only where it can be: the object's rectangle at the last good
+  // pose grown by the reach (the whole frame once the reach covers it). Cheaper on the first
+  // lost frames, and ORB's feature budget is not spent on clutter the pose may not go to.
+  const double reach_px = search_reach_px();
+  cv::Rect region;  // empty: the whole frame
+  if (reach_px > 0.0) {
+    region = relocalizer_->region_around(monitor_.last_good_pose(), tracker_->camera(), 0.0, reach_px);
+    if (region.area() <= 0) return false;
+  }
+  const Relocalization found = relocalizer_->locate(gray, tracker_->camera(), region);
+  if (!found.found) return false;
+  if (!within_reach(found.object_to_camera, reach_px)) return false;
   adopt_relocalized(frame, found.object_to_camera, result);
   return true;
 }

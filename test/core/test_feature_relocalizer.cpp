@@ -48,6 +48,32 @@ TEST_F(FeatureRelocalizerTest, FindsTheObjectFarFromItsKeyframePose) {
   EXPECT_LT(translation_error(in_region.object_to_camera, moved), 0.003);
 }
 
+TEST_F(FeatureRelocalizerTest, RegionAroundGrowsByPixelsAndIsEmptyOutsideTheImage) {
+  const Pose pose = test::make_pose(0.4);
+  FeatureRelocalizer relocalizer(mesh_);
+  const cv::Rect tight = relocalizer.region_around(pose, camera_, 0.0);
+  ASSERT_GT(tight.area(), 0);
+  // 20 px on every side (exactly, up to the rounding of the corners: 1 px).
+  const cv::Rect grown = relocalizer.region_around(pose, camera_, 0.0, 20.0);
+  EXPECT_NEAR(grown.x, tight.x - 20, 1);
+  EXPECT_NEAR(grown.y, tight.y - 20, 1);
+  EXPECT_NEAR(grown.width, tight.width + 40, 2);
+  EXPECT_NEAR(grown.height, tight.height + 40, 2);
+  // The object 1 m to the side (far outside the image): empty, also grown by less than that.
+  Pose aside = pose;
+  aside.translation().x() += 1.0;
+  EXPECT_EQ(relocalizer.region_around(aside, camera_, 0.0, 50.0).area(), 0);
+  // A region that leaves the object out finds nothing; the same one grown to reach it does.
+  ASSERT_GE(relocalizer.add_keyframe(gray_at(renderer_, pose, 1), pose, camera_), 50);
+  const Pose moved = test::move(pose, 5.0, {0.2, 1.0, 0.4}, {0.12, 0.0, 0.0});  // ~180 px right
+  const cv::Mat frame = gray_at(renderer_, moved, 2);
+  EXPECT_FALSE(relocalizer.locate(frame, camera_, relocalizer.region_around(pose, camera_, 0.0)).found);
+  const Relocalization reached =
+      relocalizer.locate(frame, camera_, relocalizer.region_around(pose, camera_, 0.0, 250.0));
+  ASSERT_TRUE(reached.found);
+  EXPECT_LT(translation_error(reached.object_to_camera, moved), 0.003);
+}
+
 TEST_F(FeatureRelocalizerTest, NothingIsFoundWithoutTheObjectOrWithoutTexture) {
   const Pose pose = test::make_pose(0.4);
   FeatureRelocalizer relocalizer(mesh_);

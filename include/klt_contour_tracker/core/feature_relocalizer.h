@@ -71,9 +71,10 @@ class FeatureRelocalizer {
                         const cv::Rect& region = cv::Rect()) const;
 
   /// The object's bounding rectangle at `object_to_camera`, grown by `margin` x its larger side
-  /// on every side, clipped to the image (px): a region for locate().
+  /// plus `grow_px` on every side, clipped to the image (px; empty when it lies outside): a
+  /// region for locate(). The whole image when a corner of the object is behind the camera.
   cv::Rect region_around(const Pose& object_to_camera, const PinholeCamera& camera,
-                         double margin) const;
+                         double margin, double grow_px = 0.0) const;
 
   int keyframes() const { return static_cast<int>(keyframes_.size()); }
   void clear() { keyframes_.clear(); }

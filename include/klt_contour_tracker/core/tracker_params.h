@@ -154,8 +154,9 @@ struct TrackerParams {
   /// relocalization_while_tracking each tracked frame they are matched around the tracked
   /// pose, and a PnP pose from at least
   /// relocalization_override_inliers features that disagrees with a track in doubt (KLT failed
-  /// or the last frame was bad) replaces it; while lost they are matched over the whole frame to
-  /// re-acquire. Textured objects only (an
+  /// or the last frame was bad) replaces it; while lost they are matched where the object can be
+  /// (its rectangle at the last good pose grown by color_search_reach_diameters' reach; the whole
+  /// frame without a reach) to re-acquire. Textured objects only (an
   /// untextured one never gives enough features: the option then does nothing).
   bool feature_relocalization = false;
   int relocalization_override_inliers = 25;  ///< PnP inliers needed to replace a held track
