@@ -72,6 +72,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     # ... and its find taken only above color_accept_ratio (not also when it beats the held pose)
     ("realtime_no_extrapolated_accept", "realtime", {"extrapolated_accept_margin": "0"}),
     ("realtime_no_tracked_search", "realtime", {"tracked_search_ratio": "0"}),
+    # ... and its find taken even where the held pose's surface pattern agrees and the find's does not
+    ("realtime_no_tracked_surface_check", "realtime", {"tracked_search_surface_drop": "0"}),
     # contour points next to anchors whose KLT track just failed (an occluder) are kept
     ("realtime_no_occlusion_mask", "realtime", {"occlusion_mask_radius_px": "0"}),
     # while lost, a frame recovers on its contour and keypoints alone (a static distractor too)

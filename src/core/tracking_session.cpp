@@ -50,6 +50,9 @@ constexpr double kTrackedSearchMinEnergyLevel = 0.7;
 /// were, each refining 23 hypotheses for nothing (the grey castle, whose colours stay faded,
 /// searched on most frames at ~200 ms each).
 constexpr double kTrackedSearchRefineSlack = 0.15;
+/// tracked_search_surface_drop: the held pose's surface must correlate at least this well for
+/// its find to be asked to (a weaker correlation does not say where the surface is).
+constexpr double kSurfaceDropMinHeldCorrelation = 0.5;
 /// texture_align_below: the alignment's bounds (turn about the centre, degrees; shift of the
 /// centre, diameters) and its budget of agreements.
 constexpr double kAlignMaxTurnDeg = 20.0;
@@ -245,6 +248,16 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       unconfirmed_.reset();
     }
     if (best_contrast < bar.min_contrast || best.energy_after < bar.min_energy) return TrackResult();
+    if (std::isfinite(bar.min_surface_correlation) && texture_ && texture_->ready()) {
+      const Pose& pose = best.object_to_camera;
+      const TextureAgreement agreement =
+          texture_->agreement(texture_->prepare(bgr, pose, camera), pose, camera);
+      // A find that shows too little of the learned surface cannot stand against a held pose
+      // whose surface agrees.
+      if (agreement.points < SurfaceTexture::kMinPoints ||
+          agreement.correlation < bar.min_surface_correlation)
+        return TrackResult();
+    }
     if (best_contrast >= params_.color_accept_ratio * monitor_.color_level() || confirmed ||
         best_contrast >= bar.accept_contrast) {
       // The taken pose confirms the next frame's best when it is at the same place: while the
@@ -358,6 +371,10 @@ void TrackingSession::search_if_faded(const Frame& frame, const cv::Mat& bgr, Se
     bar.min_contrast = held_contrast + kTrackedSearchMargin * level;
     bar.min_energy = std::max(kTrackedSearchMinEnergyRatio * held.energy_after,
                               kTrackedSearchMinEnergyLevel * monitor_.energy_level());
+    if (params_.tracked_search_surface_drop > 0.0 && texture_ && texture_->ready() &&
+        texture_->has_color_pattern() &&
+        result.texture_correlation >= kSurfaceDropMinHeldCorrelation)  // NaN: not scored
+      bar.min_surface_correlation = result.texture_correlation - params_.tracked_search_surface_drop;
   } else if (params_.extrapolated_accept_margin > 0.0) {
     const double floor_ratio = params_.color_confirm_ratio > 0.0 ? params_.color_confirm_ratio : 0.5;
     bar.accept_contrast =

@@ -213,6 +213,13 @@ struct TrackerParams {
   /// are laid on the background, which then "tracks" perfectly); the colours tell, and the
   /// search finds the object again before the loss is declared.
   double tracked_search_ratio = 0.0;
+  /// ours (tracking session, 0 = off; with tracked_search_ratio and a learned surface with a
+  /// colour pattern): when the held pose's surface colours correlate at least 0.5 with the
+  /// learned ones, a tracked search's find must correlate no less than the held pose's minus
+  /// this. The colours of a thing wearing the object's colours beside it can beat a held pose
+  /// whose contrast faded (a glossy can under a moving light), while its surface does not show
+  /// the object's printed pattern; KLT then holds the wrong find perfectly.
+  double tracked_search_surface_drop = 0.0;
   double texture_check_step_deg = 10.0;  ///< see texture_check_margin
   /// texture_check runs on every tracked frame, not only in rotation_check's window, when the
   /// learned surface has a colour pattern (SurfaceTexture::has_color_pattern(): printed or

@@ -78,6 +78,9 @@ struct SearchBar {
   /// A find at least this contrast is taken even below color_accept_ratio x the level (+inf:
   /// only the accept ratio or a two-frame confirmation take it).
   double accept_contrast = std::numeric_limits<double>::infinity();
+  /// A find whose surface colours (texture_check's learned pattern) correlate below this is not
+  /// taken (-inf: not asked).
+  double min_surface_correlation = -std::numeric_limits<double>::infinity();
 };
 
 /// Tracks one rigid object in one camera's stream with loss detection and re-acquisition.
