@@ -105,7 +105,7 @@ TrackingSession::~TrackingSession() = default;
 
 void TrackingSession::set_camera(const PinholeCamera& camera) {
   if (!tracker_)
-    tracker_ = std::make_unique<Tracker>(mesh_, camera, params_);
+    tracker_ = std::make_unique<Tracker>(mesh_, camera, tracker_params());
   else
     tracker_->set_camera(camera);
   if (params_.color_search && !search_) search_ = make_search();
@@ -128,6 +128,7 @@ const Tracker& TrackingSession::tracker() const {
 void TrackingSession::initialize(const Pose& object_to_camera) {
   if (!tracker_) throw std::logic_error("TrackingSession::initialize: no camera yet (set_camera)");
   tracker_->initialize(object_to_camera);  // validates the pose
+  set_plain_surface(false);  // until the initial frame's surface is learned
   monitor_.on_initialized(object_to_camera);
   if (search_) search_->clear();  // a new track may be another scene
   if (relocalizer_) relocalizer_->clear();
@@ -152,8 +153,8 @@ void TrackingSession::reset() {
 
 void TrackingSession::set_params(const TrackerParams& params) {
   params.validate();
-  if (tracker_) tracker_->set_params(params);
   params_ = params;
+  if (tracker_) tracker_->set_params(tracker_params());
   if (!params_.feature_relocalization)
     relocalizer_.reset();
   else if (!relocalizer_ && tracker_)
@@ -168,6 +169,19 @@ void TrackingSession::set_params(const TrackerParams& params) {
     texture_.reset();
   else if (!texture_ && tracker_)
     texture_ = std::make_unique<SurfaceTexture>(mesh_);
+}
+
+TrackerParams TrackingSession::tracker_params() const {
+  TrackerParams params = params_;
+  if (plain_surface_) params.keypoint_weight *= params_.plain_surface_keypoint_scale;
+  return params;
+}
+
+void TrackingSession::set_plain_surface(bool plain) {
+  if (plain == plain_surface_) return;
+  plain_surface_ = plain;
+  // Only the refiner's cue weights change (Tracker::set_params keeps the track).
+  if (tracker_ && params_.plain_surface_keypoint_scale != 1.0) tracker_->set_params(tracker_params());
 }
 
 void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
@@ -666,8 +680,10 @@ SessionResult TrackingSession::track(const Frame& frame) {
       search_if_faded(frame, bgr, result, params_.tracked_search_ratio, true);
   }
   use_colors(bgr, result);
-  if (texture_ && !bgr.empty() && result.frame.status == TrackStatus::kInitialized)
+  if (texture_ && !bgr.empty() && result.frame.status == TrackStatus::kInitialized) {
     texture_->learn(bgr, result.frame.object_to_camera, tracker_->camera());
+    set_plain_surface(texture_->size() >= SurfaceTexture::kMinPoints && !texture_->has_color_pattern());
+  }
   ColorLossRule rule;
   rule.lost_ratio = params_.color_lost_ratio;
   rule.contour_veto_ratio = params_.color_contour_veto_ratio;

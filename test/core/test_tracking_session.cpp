@@ -2,6 +2,8 @@
 // jump behind one track() call. A coarse visibility table keeps the test quick.
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "klt_contour_tracker/core/tracking_session.h"
 #include "synthetic_scene.h"
 
@@ -756,6 +758,53 @@ TEST(TrackingSession, ATrackedSearchFindWithoutTheObjectsSurfaceIsNotTaken) {
       EXPECT_GT(searched, 0) << "the decoy was never searched for: the test shows nothing";
       EXPECT_GT(worst_error_m, 0.1) << "the decoy was not taken: the test shows nothing";
     }
+  }
+}
+
+/// plain_surface_keypoint_scale: the surface learned on a uniformly coloured box's initial frame
+/// has no colour pattern, so that track's refinement weighs its keypoints less; a printed box's
+/// keeps the weight, and so does a track started on a grey frame (nothing learned). A new start
+/// is judged again.
+TEST(TrackingSession, AnObjectWithoutAColourPatternWeighsItsKeypointsLess) {
+  const TrackerParams params = quick_realtime();
+  ASSERT_LT(params.plain_surface_keypoint_scale, 1.0) << "realtime scales them";
+  const double weight = params.keypoint_weight;
+  const double plain_weight = weight * params.plain_surface_keypoint_scale;
+  ASSERT_LT(plain_weight, weight);
+  const PinholeCamera camera = test::make_camera();
+  const cv::Mat background = test::make_background(camera.size(), 5) * 0.5 + cv::Scalar(90, 70, 40);
+  const Pose start = test::make_pose(0.45);
+  auto plain = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1, false));
+  plain->base_color = cv::Vec3b(30, 120, 210);  // orange, as the benchmark's toy
+  auto printed = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1, true));
+  const auto frame_of = [&](const Renderer& renderer, bool grey) {
+    cv::Mat frame = test::render_frame(renderer, camera, start, background, 1.5, 0);
+    if (grey) cv::cvtColor(frame, frame, cv::COLOR_BGR2GRAY);
+    return frame;
+  };
+  struct Case {
+    std::shared_ptr<Mesh> mesh;
+    bool grey, plain;
+    const char* what;
+  };
+  for (const Case& c : {Case{plain, false, true, "plain box"}, Case{printed, false, false, "printed box"},
+                        Case{plain, true, false, "plain box, grey frame"}}) {
+    const Renderer renderer(c.mesh);
+    TrackingSession session(c.mesh, params);
+    session.set_camera(camera);
+    session.initialize(start);
+    EXPECT_FALSE(session.plain_surface()) << c.what << ": nothing learned before the first frame";
+    double stamp = 0.0;
+    for (int i = 0; i < 3; ++i, stamp += 0.033)
+      ASSERT_EQ(session.track({frame_of(renderer, c.grey), stamp}).state, TrackState::kTracking) << c.what;
+    EXPECT_EQ(session.plain_surface(), c.plain) << c.what;
+    EXPECT_DOUBLE_EQ(session.tracker().params().keypoint_weight, c.plain ? plain_weight : weight) << c.what;
+    EXPECT_DOUBLE_EQ(session.params().keypoint_weight, weight) << c.what << ": the session's own params keep it";
+    // Started again on a grey frame: nothing learned, the weight is the preset's again.
+    session.initialize(start);
+    session.track({frame_of(renderer, true), stamp});
+    EXPECT_FALSE(session.plain_surface()) << c.what;
+    EXPECT_DOUBLE_EQ(session.tracker().params().keypoint_weight, weight) << c.what;
   }
 }
 

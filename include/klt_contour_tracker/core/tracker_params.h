@@ -220,6 +220,13 @@ struct TrackerParams {
   /// whose contrast faded (a glossy can under a moving light), while its surface does not show
   /// the object's printed pattern; KLT then holds the wrong find perfectly.
   double tracked_search_surface_drop = 0.0;
+  /// ours (tracking session, 1 = off; needs texture_check_margin): when the surface learned on
+  /// the initial frame (SurfaceTexture, colour frames only) shows no colour pattern
+  /// (SurfaceTexture::has_color_pattern() false: a uniformly coloured or grey object), the
+  /// refinement's keypoint_weight is multiplied by this for that track. Such an object's
+  /// corners are its outline's and its shading's, which slide with the silhouette and the
+  /// light; the contour is then the better cue. Grey frames (nothing learned) keep the weight.
+  double plain_surface_keypoint_scale = 1.0;
   double texture_check_step_deg = 10.0;  ///< see texture_check_margin
   /// texture_check runs on every tracked frame, not only in rotation_check's window, when the
   /// learned surface has a colour pattern (SurfaceTexture::has_color_pattern(): printed or

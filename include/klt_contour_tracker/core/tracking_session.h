@@ -122,6 +122,9 @@ class TrackingSession {
   const Tracker& tracker() const;
   const Mesh& mesh() const { return *mesh_; }
   const TrackerParams& params() const { return params_; }
+  /// The track's learned surface shows no colour pattern (plain_surface_keypoint_scale applies
+  /// to it); false before a colour frame was learned at the initial pose.
+  bool plain_surface() const { return plain_surface_; }
   const TrackQualityParams& quality_params() const { return monitor_.params(); }
   /// Validate and replace the parameters (std::invalid_argument); keep the track.
   void set_params(const TrackerParams& params);
@@ -169,6 +172,11 @@ class TrackingSession {
   /// The tracker continues from the relocalizer's `object_to_camera`; `result` reports it
   /// (kReacquired, relocalized).
   void adopt_relocalized(const Frame& frame, const Pose& object_to_camera, SessionResult& result);
+  /// params_ as the tracker gets them: keypoint_weight scaled for a plain surface.
+  TrackerParams tracker_params() const;
+  /// Records whether the track's surface is plain and gives the tracker its params again when
+  /// that changes their keypoint weight.
+  void set_plain_surface(bool plain);
   /// extrapolated_search_ratio (a frame where KLT failed) and tracked_search_ratio (a frame KLT
   /// tracked): when the held pose's colour contrast is below `ratio` x its level, the frame is
   /// searched for the object at once. `must_beat_held`: the find replaces the held pose only
@@ -214,6 +222,7 @@ class TrackingSession {
   bool has_last_stamp_ = false;
   double last_stamp_s_ = 0.0;
   int lost_at_frame_ = -1;  ///< statistics_.frames when the current loss was declared
+  bool plain_surface_ = false;  ///< see plain_surface()
   /// The previous frame's best re-acquisition hypothesis above color_confirm_ratio, if any.
   std::optional<Pose> unconfirmed_;
   SessionStatistics statistics_;
