@@ -22,7 +22,9 @@ CoarseToFineResult CoarseToFineOptimizer::minimize(PoseCostSum& cost, const Pose
   if (begin_frame) cost.begin_frame(frame);
 
   Pose pose = start;
-  for (int level = static_cast<int>(frame.levels.size()) - 1; level >= 0; --level) {
+  int top = static_cast<int>(frame.levels.size()) - 1;
+  if (settings.coarsest_level >= 0) top = std::min(top, settings.coarsest_level);
+  for (int level = top; level >= 0; --level) {
     const PinholeCamera& camera = frame.levels[level].camera;
     double damping = settings.initial_damping;
     for (int iteration = 0; iteration < settings.iterations_per_level; ++iteration) {

@@ -211,6 +211,7 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
   CoarseToFineSettings settings;
   settings.iterations_per_level = params_.iterations_per_level;
   settings.max_step_px = params_.max_step_px;
+  settings.coarsest_level = coarsest_level(camera, preliminary);
   const CoarseToFineOptimizer optimizer;
   // begin_frame() already ran in prepare_frame(): the optimizer must not repeat it.
   // Starts: the preliminary pose and, without keypoints, the best image-plane shift of it
@@ -218,7 +219,7 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
   std::vector<Pose> starts{preliminary};
   Pose shifted;
   if (!cost_frame_.keypoints && params_.shift_search_diameters > 0.0 &&
-      search_shift(preliminary, &shifted))
+      search_shift(preliminary, settings.coarsest_level, &shifted))
     starts.push_back(shifted);
   CoarseToFineResult optimized;
   int iterations = 0, evaluations = 0;
@@ -277,11 +278,20 @@ RefineResult PoseRefiner::refine_coarse_to_fine(const cv::Mat& gray, const Pinho
   return result;
 }
 
-bool PoseRefiner::search_shift(const Pose& preliminary, Pose* shifted) {
-  // An exhaustive search over a disc of shifts at the coarsest level (a few hundred to ~1300
-  // evaluations of Eq. 5 over <= kMaxSamples fixed points, no derivatives): cheaper and more
-  // predictable than widening the optimizer's basin, and only run when KLT gave no pose.
-  const int level = static_cast<int>(cost_frame_.levels.size()) - 1;
+int PoseRefiner::coarsest_level(const PinholeCamera& camera, const Pose& preliminary) const {
+  int level = params_.pyramid_levels - 1;
+  if (!(params_.pyramid_min_object_px > 0.0) || level <= 0) return level;
+  const double depth = (preliminary * center_object_).z();
+  if (!(depth > 0.0)) return level;
+  const double size_px = camera.fx() * size_m_ / depth;
+  while (level > 0 && std::ldexp(size_px, -level) < params_.pyramid_min_object_px) --level;
+  return level;
+}
+
+bool PoseRefiner::search_shift(const Pose& preliminary, int level, Pose* shifted) {
+  // An exhaustive search over a disc of shifts at the coarsest level refined (a few hundred to
+  // ~1300 evaluations of Eq. 5 over <= kMaxSamples fixed points, no derivatives): cheaper and
+  // more predictable than widening the optimizer's basin, and only run when KLT gave no pose.
   const PinholeCamera& camera = cost_frame_.levels[level].camera;
   const Eigen::Vector3d center_camera = preliminary * center_object_;
   if (!(center_camera.z() > 0.0)) return false;

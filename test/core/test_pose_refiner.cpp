@@ -102,6 +102,51 @@ TEST_F(PoseRefinerTest, ShiftSearchKeepsAPoseThatIsAlreadyRight) {
   EXPECT_LT(translation_error(result.object_to_camera, truth_), 0.002);
 }
 
+/// pyramid_min_object_px: the refinement starts at the coarsest level where the object's
+/// diameter is still at least that many px (level l: 1 / 2^l of the resolution).
+TEST_F(PoseRefinerTest, ASmallObjectIsRefinedFromAFinerPyramidLevel) {
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 3;
+  ASSERT_EQ(params.pyramid_levels, 3);
+  params.pyramid_min_object_px = 40.0;
+  PoseRefiner refiner(mesh_, params);
+  // The distance at which the box's diameter is `px` across.
+  const auto at_size = [&](double px) {
+    return test::make_pose(camera_.fx() * mesh_->diameter() / px);
+  };
+  EXPECT_EQ(refiner.coarsest_level(camera_, at_size(200.0)), 2);  // 50 px at level 2
+  EXPECT_EQ(refiner.coarsest_level(camera_, at_size(150.0)), 1);  // 37.5 at level 2, 75 at 1
+  EXPECT_EQ(refiner.coarsest_level(camera_, at_size(79.0)), 0);   // 39.5 at level 1
+  EXPECT_EQ(refiner.coarsest_level(camera_, at_size(20.0)), 0);
+  params.pyramid_min_object_px = 0.0;  // off: always the pyramid's coarsest
+  PoseRefiner off(mesh_, params);
+  EXPECT_EQ(off.coarsest_level(camera_, at_size(20.0)), 2);
+}
+
+TEST_F(PoseRefinerTest, ASmallObjectRefinedFromAFinerLevelComesBack) {
+  // The box 1.3 m away (about 70 px across) on the textured table, the extrapolated pose
+  // 4 % too far and 3 deg turned.
+  const Pose far = test::make_pose(1.3);
+  cv::Mat gray;
+  cv::cvtColor(test::render_frame(renderer_, camera_, far, background_, 2.0, 1), gray,
+               cv::COLOR_BGR2GRAY);
+  const Pose off = test::move(far, 3.0, {0, 1, 0}, far.translation() * 0.04);
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 3;
+  params.pyramid_min_object_px = 40.0;
+  PoseRefiner refiner(mesh_, params);
+  ASSERT_EQ(refiner.coarsest_level(camera_, off), 0);
+  const RefineResult result = refiner.refine(gray, camera_, off, nullptr);
+  // Tolerance: 1.5 % of the distance and 2 deg (a pixel of a 70 px silhouette is 1.4 %).
+  EXPECT_LT(translation_error(result.object_to_camera, far), 0.015 * 1.3);
+  EXPECT_LT(rotation_error_deg(result.object_to_camera, far), 2.0);
+  // From the pyramid's coarsest level (the box 18 px across there) the refinement turns it away:
+  // the finer start is what brings it back.
+  params.pyramid_min_object_px = 0.0;
+  PoseRefiner coarse(mesh_, params);
+  EXPECT_GT(rotation_error_deg(coarse.refine(gray, camera_, off, nullptr).object_to_camera, far), 5.0);
+}
+
 TEST_F(PoseRefinerTest, SameSeedSameResult) {
   const Pose perturbed = test::move(truth_, 4.0, {0, 0, 1}, {0.0, 0.004, 0.0});
   PoseRefiner a(mesh_, params_), b(mesh_, params_);

@@ -22,6 +22,8 @@ struct CoarseToFineSettings {
   /// a coordinate axis (a can turning about its own axis, whose outline does not change): the
   /// solve then returns an arbitrarily long step driven by noise.
   double max_step_px = 0.0;
+  /// The level to start at (-1 = the pyramid's coarsest; larger values are clamped to it).
+  int coarsest_level = -1;
 };
 
 /// Outcome of CoarseToFineOptimizer::minimize().

@@ -55,6 +55,11 @@ class PoseRefiner {
   /// True when cues were added with add_cue().
   bool has_added_cues() const { return !extra_cues_.empty(); }
 
+  /// The pyramid level the coarse_to_fine refinement of `preliminary` starts at: the coarsest
+  /// (pyramid_levels - 1), or the coarsest at which the object's diameter is still at least
+  /// pyramid_min_object_px (level l has 1 / 2^l of the resolution); 0 at the least.
+  int coarsest_level(const PinholeCamera& camera, const Pose& preliminary) const;
+
   /// Refines `preliminary` on `gray` (CV_8UC1). `keypoints` holds the KLT inliers when the
   /// preliminary pose came from PnP (search area = reprojection constraint, Sec. 3.4), or is
   /// null when it was extrapolated (search area = Euler/translation box).
@@ -102,7 +107,7 @@ class PoseRefiner {
                                      const cv::Mat& occlusion_mask);
   /// shift_search_diameters (see TrackerParams): the image-plane shift of `preliminary` with
   /// the highest contour energy on the coarsest level, when it beats the unshifted pose.
-  bool search_shift(const Pose& preliminary, Pose* shifted);
+  bool search_shift(const Pose& preliminary, int level, Pose* shifted);
   void build_cues();
   PoseCostFrame cost_frame_;
   PoseCostSum costs_;

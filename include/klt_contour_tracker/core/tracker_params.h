@@ -300,6 +300,11 @@ struct TrackerParams {
   /// analytic gradient, the keypoint reprojection) over an image pyramid, coarsest first.
   std::string optimizer = "basin_hopping";
   int pyramid_levels = 3;                  ///< ours: coarse_to_fine levels, 1 = full resolution
+  /// ours (0 = off): coarse_to_fine starts at the coarsest level where the object (its
+  /// diameter at the preliminary pose) is at least this many px across, not coarser. A small
+  /// object (40-130 px, 1 m away) shrinks to 10-30 px at a quarter of the resolution, where its
+  /// outline is a blur among the clutter's edges and takes the pose away in depth.
+  double pyramid_min_object_px = 0.0;
   int iterations_per_level = 4;            ///< ours: coarse_to_fine linearizations per level
   double contour_weight = 1.0;             ///< ours: coarse_to_fine weight of the contour cue
   /// ours: coarse_to_fine weight of the keypoint cue. Weak on purpose: the contour cue must be
