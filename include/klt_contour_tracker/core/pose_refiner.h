@@ -106,7 +106,8 @@ class PoseRefiner {
                                      const Pose& preliminary, const KeypointResult* keypoints,
                                      const cv::Mat& occlusion_mask);
   /// shift_search_diameters (see TrackerParams): the image-plane shift of `preliminary` with
-  /// the highest contour energy on the coarsest level, when it beats the unshifted pose.
+  /// the highest contour energy on pyramid `level` (coarsest_level()'s), when it beats the
+  /// unshifted pose.
   bool search_shift(const Pose& preliminary, int level, Pose* shifted);
   void build_cues();
   PoseCostFrame cost_frame_;
