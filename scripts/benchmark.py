@@ -88,6 +88,9 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_corner_fallback", "realtime", {"corner_fallback_below": "0"}),
     # keypoints anchored after a KLT failure kept even when the frame is judged bad
     ("realtime_keep_anchors", "realtime", {"drop_unconfirmed_anchors": "false"}),
+    # while lost, a frame the searches did not re-acquire is refined around the last good pose
+    # (not tracked on from where the last frame ended)
+    ("realtime_no_track_while_lost", "realtime", {"track_while_lost": "false"}),
     # ORB keyframes matched while lost (feature_relocalizer.h) off: the colour search alone
     ("realtime_no_feature_relocalization", "realtime", {"feature_relocalization": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)

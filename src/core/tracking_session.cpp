@@ -283,6 +283,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     }
   }
   if (color_only) return TrackResult();
+  if (params_.track_while_lost) return tracker_->track(frame);
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 

@@ -63,6 +63,41 @@ TEST(TrackingSession, AnchorsLaidOnABadFrameAreDroppedWhenAsked) {
   }
 }
 
+/// track_while_lost: the monitor is made to judge every frame bad (min_quality above any score),
+/// so the session is LOST from the fifth frame while the box, in plain view, slides 4 mm a frame.
+/// Refined around the last good pose (the given one) every lost frame, the pose stays behind;
+/// tracked from where the last frame ended, it follows the box.
+TEST(TrackingSession, WhileLostAMovingObjectIsTrackedFromWhereTheLastFrameEnded) {
+  const Scene scene;
+  const auto pose = [&](int i) {
+    return test::move(scene.pose(0), 0.3 * i, {0.2, 1.0, 0.0}, {0.004 * i, 0.001 * i, 0.0});
+  };
+  TrackQualityParams quality;
+  quality.min_quality = 1.0;
+  quality.energy_weight = 1.0;  // the energy ratio alone, below 1 after the first frames
+  for (const bool track_while_lost : {false, true}) {
+    TrackerParams params = quick_paper();
+    params.track_while_lost = track_while_lost;
+    TrackingSession session(scene.mesh, params, quality);
+    session.set_camera(scene.camera);
+    session.initialize(pose(0));
+    double stamp = 1.0;
+    SessionResult last;
+    int lost_frames = 0;
+    for (int i = 0; i < 25; ++i, stamp += 0.033) {
+      last = session.track({test::render_frame(scene.renderer, scene.camera, pose(i), scene.background, 1.5, i),
+                            stamp});
+      lost_frames += last.state == TrackState::kLost ? 1 : 0;
+    }
+    ASSERT_GE(lost_frames, 15) << "the monitor must keep the session lost";
+    const double error_m = translation_error(last.frame.object_to_camera, pose(24));
+    if (track_while_lost)
+      EXPECT_LT(error_m, 0.005) << "followed while lost";
+    else
+      EXPECT_GT(error_m, 0.03) << "refined around the last good pose, 96 mm behind";
+  }
+}
+
 TEST(TrackingSession, LosesTheHiddenObjectAndReacquiresItWhenItComesBack) {
   const Scene scene;
   TrackingSession session(scene.mesh, quick_paper());
@@ -540,6 +575,10 @@ TEST(TrackingSession, WeakColourPlacementIsTakenWhenTwoFramesAgree) {
   params.feature_relocalization = false;  // the colour search alone (its features find it too)
   ASSERT_GT(params.color_confirm_ratio, 0.0) << "realtime confirms weak placements";
   params.color_accept_ratio = 0.95;
+  // The lost frames refined around the last good pose: tracked on instead (track_while_lost),
+  // they are KLT failures whose extrapolated-search find is taken when it beats the held pose
+  // (extrapolated_accept_margin), another rule than the one tested here.
+  params.track_while_lost = false;
   for (const double confirm : {0.0, params.color_confirm_ratio}) {
     params.color_confirm_ratio = confirm;
     TrackingSession session(mesh, params);

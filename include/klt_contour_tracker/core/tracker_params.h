@@ -149,6 +149,15 @@ struct TrackerParams {
   /// background or a spun copy of the object consistently, and look healthy); the next frame is
   /// refined from the contour again and anchors afresh.
   bool drop_unconfirmed_anchors = false;
+  /// ours (tracking session; false = refine around the last good pose, as before): while LOST,
+  /// a frame where neither the feature relocalizer nor the colour search re-acquired the object
+  /// is tracked by the pipeline from where the last frame ended (KLT, extrapolation, refinement;
+  /// then the session's checks of a tracked frame, e.g. extrapolated_search_ratio's search when
+  /// KLT failed) instead of being refined around the last good pose with the widened search
+  /// area. The last good pose is frames old: a hand-held object has moved on since (and is
+  /// often still held right while blur or an occluder made its frames bad), so refining there
+  /// takes a held pose away; the colour search still looks for the object on every lost frame.
+  bool track_while_lost = false;
   /// ours (tracking session, feature_relocalizer.h): ORB features of keyframes (the initial
   /// pose, then good frames from new viewpoints) anchored on the mesh; with
   /// relocalization_while_tracking each tracked frame they are matched around the tracked

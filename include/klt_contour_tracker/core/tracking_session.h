@@ -137,8 +137,9 @@ class TrackingSession {
   /// The colour model, its searches on params_.num_threads threads.
   std::unique_ptr<ObjectSearch> make_search() const;
   /// Re-acquisition while lost: the colour search's hypotheses, else (not `color_only`) a
-  /// refinement around the last good pose. `color_only` and nothing found (or nothing above
-  /// `bar`): a default result (searched false).
+  /// refinement around the last good pose, or with track_while_lost the pipeline's frame from
+  /// where the last frame ended. `color_only` and nothing found (or nothing above `bar`): a
+  /// default result (searched false).
   TrackResult reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched,
                         bool color_only = false, const SearchBar& bar = SearchBar());
   /// color_search_reach_diameters: how far (full-resolution px) from the last good pose's
