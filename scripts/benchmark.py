@@ -556,10 +556,11 @@ def reacquired_right_in_time(row):
 def reacquired_right_once_visible(row):
     """Issue 11's measure: (right, losses) where losses are the losses after which the object is
     visible again (at least HARD_MIN_VISIBLE of it, `visible_errors` not None) before the sequence
-    ends, and right are those of them re-acquired within REACQUIRE_WITHIN_FRAMES of the first such
-    frame (at or after the loss) with a right pose (error < WRONG_POSE_DIAMETERS diameters). A
-    re-acquisition before the object is back (on the background) is not right. None without a
-    trace or visibility."""
+    ends, and right are those of them re-acquired within REACQUIRE_WITHIN_FRAMES of the frame it
+    is visible from (the first such frame at or after the loss; when the object is out of sight
+    for a while after the loss, before the re-acquisition, the frame it is back from) with a right
+    pose (error < WRONG_POSE_DIAMETERS diameters). A re-acquisition before the object is back (on
+    the background) is not right. None without a trace or visibility."""
     states, errors, visible = row.get("states"), row.get("errors", []), row.get("visible_errors")
     if states is None or visible is None or not (len(states) == len(errors) == len(visible)):
         return None
@@ -569,8 +570,12 @@ def reacquired_right_once_visible(row):
         if not (states[i - 1] == "tracking" and states[i] == "lost"):
             i += 1
             continue
-        back = next((k for k in range(i, len(states)) if visible[k] is not None), None)
         end = next((k for k in range(i + 1, len(states)) if states[k] == "tracking"), None)
+        # The object left the image (or the occluder hid it) after the loss: the clock starts
+        # when it is back, not at the loss, while it was still partly in view.
+        hidden = [k for k in range(i, len(states) if end is None else end) if visible[k] is None]
+        start = hidden[-1] + 1 if hidden else i
+        back = next((k for k in range(start, len(states)) if visible[k] is not None), None)
         if back is not None:
             losses += 1
             if (end is not None and back <= end <= back + REACQUIRE_WITHIN_FRAMES and
@@ -1190,7 +1195,8 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
                  "frames of being visible, right* (issue 11's measure): of the losses after which the "
                  "object is visible again (the share is of those), the ones re-acquired right within "
                  "%d frames of the first frame at or after the loss where at least %d %% of it is in the image and "
-                 "not occluded (a re-acquisition before that frame is on something else, never right); the "
+                 "not occluded (when it leaves the image after the loss, of the frame it is back from; a "
+                 "re-acquisition before that frame is on something else, never right); the "
                  "median is over the re-acquired losses.\n"
                  % (REACQUIRE_WITHIN_FRAMES, leave_args[leave_args.index("--leave-frames") + 1],
                     WRONG_POSE_DIAMETERS, REACQUIRE_WITHIN_FRAMES, REACQUIRE_WITHIN_FRAMES,
