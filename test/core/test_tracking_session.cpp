@@ -116,18 +116,19 @@ TEST(TrackingSession, LosesTheHiddenObjectAndReacquiresItWhenItComesBack) {
     EXPECT_EQ(r.state, TrackState::kTracking) << frame;
     EXPECT_LT(translation_error(r.frame.object_to_camera, scene.pose(frame)), 0.005) << frame;
   }
-  // Frames 6-17 hidden: LOST within lost_after_bad_frames (5) + 2 frames (the energy level
+  // Frames 6-17 hidden: LOST within lost_after_bad_frames (3) + 2 frames (the energy level
   // drops at once when the contour sits on background only; KLT fails at once).
+  const int lost_after = session.quality_params().lost_after_bad_frames;
   int lost_at = -1;
   for (; frame < 18; ++frame, stamp += 0.033) {
     const SessionResult r = session.track({scene.hidden(frame), stamp});
     if (r.state == TrackState::kLost && lost_at < 0) lost_at = frame;
   }
   ASSERT_GE(lost_at, 6);
-  EXPECT_LE(lost_at, 6 + 5 + 2);
+  EXPECT_LE(lost_at, 6 + lost_after + 2);
   EXPECT_EQ(session.state(), TrackState::kLost);
   EXPECT_EQ(session.statistics().losses, 1);
-  EXPECT_GE(session.statistics().frames_lost, 18 - (6 + 5 + 2));
+  EXPECT_GE(session.statistics().frames_lost, 18 - (6 + lost_after + 2));
   // Back in view where it was lost (slow drift): re-acquired within 10 frames, pose right.
   int back_at = -1;
   for (int k = 0; k < 10; ++k, ++frame, stamp += 0.033) {
@@ -472,7 +473,7 @@ TEST(TrackingSession, ATrackHeldOnTheBackgroundIsSearchedForBeforeTheLoss) {
     stamp += 0.033;
     ASSERT_FALSE(jump.searched) << "the jump frame is not searched here";
     ASSERT_GT(translation_error(jump.frame.object_to_camera, away), 0.05) << "no jump: no test";
-    // The next two frames, before the loss can be declared (lost_after_bad_frames = 5).
+    // The next two frames, before the loss can be declared (lost_after_bad_frames = 3).
     int keypoint_frames = 0;
     SessionResult found;
     for (int i = 0; i < 2 && !found.searched; ++i, stamp += 0.033) {

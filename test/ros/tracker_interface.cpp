@@ -267,7 +267,7 @@ TEST(TrackerInterface, LostWhileHiddenAndReacquiredWhenTheObjectComesBack) {
       {"preset", XmlRpc::XmlRpcValue("paper")},
       {"icosphere_subdivisions", XmlRpc::XmlRpcValue(2)},
       {"visibility_resolution_px", XmlRpc::XmlRpcValue(128)},
-      {"lost_after_bad_frames", XmlRpc::XmlRpcValue(3)},
+      {"lost_after_bad_frames", XmlRpc::XmlRpcValue(4)},  // not the default (3)
       {"recover_after_good_frames", XmlRpc::XmlRpcValue(2)},
       {"object_frame", XmlRpc::XmlRpcValue("crate_lost")}};
   set_initial_pose(params, truth);
@@ -303,8 +303,8 @@ TEST(TrackerInterface, LostWhileHiddenAndReacquiredWhenTheObjectComesBack) {
       EXPECT_FALSE(status->pose_published) << "hidden frame " << i;
     }
   }
-  EXPECT_EQ(lost_at, 2) << "LOST on the third bad frame (~lost_after_bad_frames 3)";
-  EXPECT_LE(harness.poses().size(), poses_before_hiding + 2);
+  EXPECT_EQ(lost_at, 3) << "LOST on the fourth bad frame (~lost_after_bad_frames 4)";
+  EXPECT_LE(harness.poses().size(), poses_before_hiding + 3);
 
   truth = kct::test::move(truth, 3.0, {0.2, 1.0, 0.0}, {0.006, -0.002, 0.0});
   int tracking_again_at = -1;

@@ -76,7 +76,7 @@ struct TrackQualityParams {
   /// Exponential-moving-average factor of the energy level over good frames, (0, 1].
   double energy_level_smoothing = 0.1;
   /// TRACKING -> LOST after this many consecutive bad frames.
-  int lost_after_bad_frames = 5;
+  int lost_after_bad_frames = 3;
   /// LOST -> TRACKING after this many consecutive good frames.
   int recover_after_good_frames = 3;
   /// While lost, the extrapolated search box (Sec. 3.4) is scaled by this for re-acquisition.
