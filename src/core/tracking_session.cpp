@@ -200,7 +200,11 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     // contrast wins.
     const PinholeCamera& camera = tracker_->camera();
     const double reach_px = search_reach_px();
-    std::vector<SearchCandidate> found = search_->search(bgr, last_good, camera, reach_px);
+    if (!frame_search_.searched) {
+      frame_search_.found = search_->search(bgr, last_good, camera, reach_px);
+      frame_search_.searched = true;
+    }
+    std::vector<SearchCandidate> found = frame_search_.found;
     if (static_cast<int>(found.size()) > params_.color_search_placements)
       found.resize(static_cast<std::size_t>(params_.color_search_placements));
     // found: best contrast first.
@@ -235,7 +239,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       for (const Pose& turned : turned_about_center(placed, center_object, angle))
         hypotheses.push_back(turned);
     }
-    std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, hypotheses, 1.0);
+    std::vector<TrackResult> refined = refine_once(frame, hypotheses);
     if (refined.front().status != TrackStatus::kReacquired) return refined.front();  // invalid frame
     std::vector<Pose> refined_poses;
     for (const TrackResult& r : refined) refined_poses.push_back(r.object_to_camera);
@@ -285,6 +289,35 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   if (color_only) return TrackResult();
   if (params_.track_while_lost) return tracker_->track(frame);
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
+}
+
+std::vector<TrackResult> TrackingSession::refine_once(const Frame& frame,
+                                                     const std::vector<Pose>& hypotheses) {
+  std::vector<TrackResult> refined(hypotheses.size());
+  std::vector<Pose> fresh;
+  std::vector<std::size_t> fresh_index;
+  for (std::size_t i = 0; i < hypotheses.size(); ++i) {
+    const auto& starts = frame_search_.starts;
+    const auto same = std::find_if(starts.begin(), starts.end(), [&](const Pose& start) {
+      return start.matrix() == hypotheses[i].matrix();
+    });
+    if (same != starts.end()) {
+      refined[i] = frame_search_.refined[static_cast<std::size_t>(same - starts.begin())];
+    } else {
+      fresh.push_back(hypotheses[i]);
+      fresh_index.push_back(i);
+    }
+  }
+  if (fresh.empty()) return refined;
+  const std::vector<TrackResult> done = tracker_->refine_hypotheses(frame, fresh, 1.0);
+  for (std::size_t k = 0; k < done.size(); ++k) {
+    refined[fresh_index[k]] = done[k];
+    // An invalid frame's results are not kept: every later call reports it again.
+    if (done[k].status != TrackStatus::kReacquired) continue;
+    frame_search_.starts.push_back(fresh[k]);
+    frame_search_.refined.push_back(done[k]);
+  }
+  return refined;
 }
 
 bool TrackingSession::within_reach(const Pose& object_to_camera, double reach_px) const {
@@ -650,6 +683,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
 
   result.reacquiring = monitor_.should_reacquire();
   if (!result.reacquiring) unconfirmed_.reset();
+  frame_search_ = FrameSearch();
   // The colour frame, when the colour model is on and the frame is in colour (checked first:
   // an invalid frame is the tracker's to report).
   cv::Mat bgr;

@@ -226,6 +226,21 @@ class TrackingSession {
   bool plain_surface_ = false;  ///< see plain_surface()
   /// The previous frame's best re-acquisition hypothesis above color_confirm_ratio, if any.
   std::optional<Pose> unconfirmed_;
+  /// This frame's colour search and refined re-acquisition hypotheses. With track_while_lost a
+  /// lost frame can be searched twice (reacquire(), then search_if_faded() on the frame it
+  /// tracked on): the second pass takes the first's placements and refinements instead of
+  /// computing them again (the same frame, last good pose and reach; a refinement depends only
+  /// on its start and the frame).
+  struct FrameSearch {
+    bool searched = false;
+    std::vector<SearchCandidate> found;  ///< ObjectSearch::search(), before any cut
+    std::vector<Pose> starts;            ///< refined hypotheses ...
+    std::vector<TrackResult> refined;    ///< ... and their refinements
+  };
+  FrameSearch frame_search_;
+  /// reacquire()'s refinement of `hypotheses` (search scale 1), from frame_search_ where a
+  /// start was refined on this frame already.
+  std::vector<TrackResult> refine_once(const Frame& frame, const std::vector<Pose>& hypotheses);
   SessionStatistics statistics_;
 };
 
