@@ -91,6 +91,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     # while lost, a frame the searches did not re-acquire is refined around the last good pose
     # (not tracked on from where the last frame ended)
     ("realtime_no_track_while_lost", "realtime", {"track_while_lost": "false"}),
+    # while lost, a find at the previous frame's find is judged by its quality score alone
+    ("realtime_no_repeat_recover", "realtime", {"repeat_recover_diameters": "0"}),
     # ORB keyframes matched while lost (feature_relocalizer.h) off: the colour search alone
     ("realtime_no_feature_relocalization", "realtime", {"feature_relocalization": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)

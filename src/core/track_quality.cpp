@@ -69,7 +69,7 @@ double TrackQualityMonitor::score(const TrackResult& result) const {
 }
 
 TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvidence& color,
-                                       const ColorLossRule& rule) {
+                                       const ColorLossRule& rule, bool repeats_previous_find) {
   if (result.status == TrackStatus::kInvalidInput) return state_;
   if (result.status == TrackStatus::kNotInitialized) {
     reset();
@@ -81,6 +81,9 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
   }
   last_quality_ = score(result);
   last_good_ = last_quality_ >= params_.min_quality;
+  // A find without keypoints scores its contour energy against a level learned on sharp frames
+  // before the loss; the same place found again on the next frame is the evidence instead.
+  if (state_ == TrackState::kLost && repeats_previous_find) last_good_ = true;
   if (color.valid && result.status != TrackStatus::kInitialized) {
     constexpr double kMinVisibleFraction = 0.1;  // the object cannot be tracked out of view
     const bool out_of_view = color.visible_fraction < kMinVisibleFraction;

@@ -320,6 +320,23 @@ std::vector<TrackResult> TrackingSession::refine_once(const Frame& frame,
   return refined;
 }
 
+bool TrackingSession::repeats_previous_find(const SessionResult& result) {
+  if (!(params_.repeat_recover_diameters > 0.0) || !result.reacquiring ||
+      result.frame.status != TrackStatus::kReacquired) {
+    previous_find_.reset();
+    return false;
+  }
+  const Pose& pose = result.frame.object_to_camera;
+  const Eigen::Vector3d& center = tracker_->center_object();
+  const bool repeats =
+      previous_find_ &&
+      ((*previous_find_ * center) - (pose * center)).norm() <
+          params_.repeat_recover_diameters * tracker_->diameter_m() &&
+      rotation_error_deg(*previous_find_, pose) < params_.repeat_recover_deg;
+  previous_find_ = pose;
+  return repeats;
+}
+
 bool TrackingSession::within_reach(const Pose& object_to_camera, double reach_px) const {
   if (reach_px <= 0.0) return true;
   const Eigen::Vector3d& center = tracker_->center_object();
@@ -732,7 +749,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   // its shading, which a wrong pose of the castle matched at >= 0.7: hard2/castle/leave -5.5).
   if (texture_ && texture_->has_color_pattern())
     result.color.surface_correlation = result.texture_correlation;
-  result.state = monitor_.update(result.frame, result.color, rule);
+  result.state = monitor_.update(result.frame, result.color, rule, repeats_previous_find(result));
   if (params_.drop_unconfirmed_anchors && result.frame.status == TrackStatus::kExtrapolated &&
       !monitor_.last_good())
     tracker_->forget_keypoints();

@@ -322,6 +322,54 @@ TEST(TrackQuality, ASurfaceThatStillMatchesHoldsABadTrackedFrame) {
   EXPECT_EQ(off.update(blurred, matching, none), TrackState::kLost);
 }
 
+/// repeats_previous_find (the session's repeat_recover_diameters): while LOST a find at the
+/// previous frame's find is good whatever its score, so the track recovers after
+/// recover_after_good_frames of them; while TRACKING it changes nothing, and the colour recovery
+/// rule still vetoes it.
+TEST(TrackQuality, AFindRepeatedWhileLostCountsAsGood) {
+  TrackQualityParams params;
+  params.lost_after_bad_frames = 3;
+  params.recover_after_good_frames = 3;
+  params.energy_level_smoothing = 1.0;  // level = the last good energy
+  TrackResult find = refined_result(4.0, false, 0.0);  // 0.7 * 0.4: bad by its score
+  find.status = TrackStatus::kReacquired;
+  const TrackResult good = refined_result(10.0, true, 0.9);
+
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  monitor.update(good);
+  // While tracking a repeated find is bad as scored: lost after 3.
+  EXPECT_EQ(monitor.update(find, {}, {}, true), TrackState::kTracking);
+  EXPECT_FALSE(monitor.last_good());
+  EXPECT_EQ(monitor.update(find, {}, {}, true), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(find, {}, {}, true), TrackState::kLost);
+  // Lost: not repeated, bad; repeated, good (its score unchanged); recovered after 3.
+  EXPECT_EQ(monitor.update(find, {}, {}, false), TrackState::kLost);
+  EXPECT_FALSE(monitor.last_good());
+  EXPECT_EQ(monitor.update(find, {}, {}, true), TrackState::kLost);
+  EXPECT_TRUE(monitor.last_good());
+  EXPECT_NEAR(monitor.last_quality(), 0.28, 1e-9);
+  EXPECT_EQ(monitor.update(find, {}, {}, true), TrackState::kLost);
+  EXPECT_EQ(monitor.update(find, {}, {}, true), TrackState::kTracking);
+
+  // The colour recovery rule still applies: a repeated find whose colours faded stays bad.
+  TrackQualityMonitor vetoed(params);
+  vetoed.on_initialized(Pose::Identity());
+  ColorEvidence bright, faded;
+  bright.valid = faded.valid = true;
+  bright.contrast = 0.6;
+  faded.contrast = 0.2;
+  ColorLossRule rule;
+  rule.recover_ratio = 0.5;
+  vetoed.update(good, bright, rule);
+  for (int i = 0; i < 3; ++i) vetoed.update(find, bright, rule);
+  ASSERT_EQ(vetoed.state(), TrackState::kLost);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(vetoed.update(find, faded, rule, true), TrackState::kLost) << i;
+    EXPECT_FALSE(vetoed.last_good()) << i;
+  }
+}
+
 TEST(TrackQuality, InvalidInputChangesNothingAndNotInitializedMeansWaiting) {
   TrackQualityParams params;
   params.lost_after_bad_frames = 1;

@@ -100,6 +100,48 @@ TEST(TrackingSession, WhileLostAMovingObjectIsTrackedFromWhereTheLastFrameEnded)
   }
 }
 
+/// repeat_recover_diameters: the monitor is made to judge every find bad by its score (no
+/// keypoints, k = 0, caps it at 0.5 below a min_quality of 1) and KLT frames nearly always, so the
+/// session gets LOST on the box standing in plain view; every lost frame is then a find (refined
+/// around the last good pose) at the same place. Judged by the score alone it never recovers;
+/// with the repeated find counted as good it recovers on the second find (one good frame
+/// recovers here: the KLT frame after a good find is bad by this monitor), on the right pose.
+TEST(TrackingSession, AFindRepeatedWhileLostRecoversTheTrack) {
+  const Scene scene;
+  TrackQualityParams quality;
+  quality.min_quality = 1.0;
+  quality.energy_weight = 0.5;
+  quality.recover_after_good_frames = 1;
+  for (const double repeat : {0.0, 0.05}) {
+    TrackerParams params = quick_paper();
+    params.repeat_recover_diameters = repeat;
+    TrackingSession session(scene.mesh, params, quality);
+    session.set_camera(scene.camera);
+    session.initialize(scene.pose(0));
+    double stamp = 1.0;
+    int lost_at = -1, recovered_at = -1;
+    SessionResult recovered;
+    for (int i = 0; i < 30 && recovered_at < 0; ++i, stamp += 0.033) {
+      const cv::Mat image =
+          test::render_frame(scene.renderer, scene.camera, scene.pose(0), scene.background, 1.5, i);
+      const SessionResult r = session.track({image, stamp});
+      if (lost_at < 0 && r.state == TrackState::kLost) lost_at = i;
+      if (lost_at >= 0 && recovered_at < 0 && r.state == TrackState::kTracking) {
+        recovered_at = i;
+        recovered = r;
+      }
+    }
+    ASSERT_GE(lost_at, 0) << "the monitor must make the session lose the box";
+    if (repeat > 0.0) {
+      ASSERT_GE(recovered_at, 0) << "repeated finds recover the track";
+      EXPECT_LE(recovered_at - lost_at, 2) << "the first find, then the same place again";
+      EXPECT_LT(translation_error(recovered.frame.object_to_camera, scene.pose(0)), 0.005);
+    } else {
+      EXPECT_LT(recovered_at, 0) << "a find scores at most 0.5: never good by its score";
+    }
+  }
+}
+
 TEST(TrackingSession, LosesTheHiddenObjectAndReacquiresItWhenItComesBack) {
   const Scene scene;
   TrackingSession session(scene.mesh, quick_paper());

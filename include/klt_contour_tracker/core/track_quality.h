@@ -114,9 +114,11 @@ class TrackQualityMonitor {
   /// than 10 % of the object is in the image or its contrast is below `rule.lost_ratio` x the
   /// running contrast level of good frames (`rule`: when the contour energy or KLT overrules that).
   /// A bad tracked frame whose surface colours still match (`rule.surface_hold_correlation`) is
-  /// held: the state, the counters and the levels do not change.
+  /// held: the state, the counters and the levels do not change. While LOST, a frame that
+  /// `repeats_previous_find` (the session's repeat_recover_diameters: re-acquired where the
+  /// previous frame was) is good whatever its score; the colour rules above still apply.
   TrackState update(const TrackResult& result, const ColorEvidence& color = {},
-                    const ColorLossRule& rule = {});
+                    const ColorLossRule& rule = {}, bool repeats_previous_find = false);
   /// Running colour contrast of good frames (0 when none yet).
   double color_level() const { return color_level_; }
   /// Colour evidence counts only once the running contrast is at least this: a model whose

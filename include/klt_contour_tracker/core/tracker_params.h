@@ -158,6 +158,16 @@ struct TrackerParams {
   /// often still held right while blur or an occluder made its frames bad), so refining there
   /// takes a held pose away; the colour search still looks for the object on every lost frame.
   bool track_while_lost = false;
+  /// ours (tracking session; 0 = off): while LOST, a re-acquired frame (the colour search's or
+  /// the feature relocalizer's find, or the refinement around the last good pose) whose pose is
+  /// within repeat_recover_diameters x the object's diameter (centre) and repeat_recover_deg
+  /// (rotation) of the previous frame's re-acquired pose counts as good towards the recovery,
+  /// whatever its quality score (color_recover_ratio and color_recover_min_visible still
+  /// apply). A find has no keypoints (k = 0) and its contour energy is judged against a level
+  /// learned on sharp frames before the loss: under sensor noise or blur a right find scores
+  /// 0.35-0.46 for ten frames while the search finds the same place every frame.
+  double repeat_recover_diameters = 0.0;
+  double repeat_recover_deg = 5.0;  ///< see repeat_recover_diameters
   /// ours (tracking session, feature_relocalizer.h): ORB features of keyframes (the initial
   /// pose, then good frames from new viewpoints) anchored on the mesh; with
   /// relocalization_while_tracking each tracked frame they are matched around the tracked

@@ -238,6 +238,11 @@ class TrackingSession {
     std::vector<TrackResult> refined;    ///< ... and their refinements
   };
   FrameSearch frame_search_;
+  /// While LOST, the previous frame's re-acquired pose (repeat_recover_diameters), if it was one.
+  std::optional<Pose> previous_find_;
+  /// repeat_recover_diameters: whether `result` (this frame's) was re-acquired where the previous
+  /// frame was; remembers it for the next frame.
+  bool repeats_previous_find(const SessionResult& result);
   /// reacquire()'s refinement of `hypotheses` (search scale 1), from frame_search_ where a
   /// start was refined on this frame already.
   std::vector<TrackResult> refine_once(const Frame& frame, const std::vector<Pose>& hypotheses);
