@@ -327,14 +327,17 @@ bool TrackingSession::repeats_previous_find(const SessionResult& result) {
     return false;
   }
   const Pose& pose = result.frame.object_to_camera;
-  const Eigen::Vector3d& center = tracker_->center_object();
-  const bool repeats =
-      previous_find_ &&
-      ((*previous_find_ * center) - (pose * center)).norm() <
-          params_.repeat_recover_diameters * tracker_->diameter_m() &&
-      rotation_error_deg(*previous_find_, pose) < params_.repeat_recover_deg;
+  const bool repeats = previous_find_ && same_place(*previous_find_, pose,
+                                                    params_.repeat_recover_diameters,
+                                                    params_.repeat_recover_deg);
   previous_find_ = pose;
   return repeats;
+}
+
+bool TrackingSession::same_place(const Pose& a, const Pose& b, double diameters, double deg) const {
+  const Eigen::Vector3d& center = tracker_->center_object();
+  return ((a * center) - (b * center)).norm() < diameters * tracker_->diameter_m() &&
+         rotation_error_deg(a, b) < deg;
 }
 
 bool TrackingSession::within_reach(const Pose& object_to_camera, double reach_px) const {
@@ -398,10 +401,7 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   const Relocalization found =
       relocalizer_->locate(gray, camera, relocalizer_->region_around(held, camera, kRegionMargin));
   if (!found.found) return;
-  const Eigen::Vector3d& center = tracker_->center_object();
-  const double moved_m = ((found.object_to_camera * center) - (held * center)).norm();
-  if (moved_m < kAgreementDiameters * tracker_->diameter_m() &&
-      rotation_error_deg(found.object_to_camera, held) < kAgreementDeg) {
+  if (same_place(held, found.object_to_camera, kAgreementDiameters, kAgreementDeg)) {
     features_confirm_ = true;
     return;
   }

@@ -148,6 +148,9 @@ class TrackingSession {
   /// True when `object_to_camera`'s centre projects within `reach_px` (a search_reach_px()) of
   /// the last good pose's; always when `reach_px` is 0.
   bool within_reach(const Pose& object_to_camera, double reach_px) const;
+  /// True when `b`'s object centre is within `diameters` x the object's diameter of `a`'s and
+  /// the rotation between them is below `deg`.
+  bool same_place(const Pose& a, const Pose& b, double diameters, double deg) const;
   /// texture_shift_search_below, from texture_check (the held pose's colours `prepared`,
   /// correlating at `held_correlation`): true when a confirmed shift replaced the held pose.
   bool shift_by_texture(const Frame& frame, const cv::Mat& bgr, const PreparedFrame& prepared,
