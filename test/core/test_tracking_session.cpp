@@ -293,6 +293,13 @@ void track_start(TrackingSession& session, const ColourScene& scene, double& sta
   }
 }
 
+/// A re-acquisition that took the object where it is: within 1 cm and 3 deg of `truth`, the
+/// tolerance of every re-acquisition test here.
+void expect_found_at(const SessionResult& r, const Pose& truth) {
+  EXPECT_LT(translation_error(r.frame.object_to_camera, truth), 0.01);
+  EXPECT_LT(rotation_error_deg(r.frame.object_to_camera, truth), 3.0);
+}
+
 /// What a correcting check (rotation_check, texture_check) did while an object came back.
 struct CheckRun {
   SessionResult last;        ///< the last frame's result
@@ -441,9 +448,7 @@ TEST(TrackingSession, AJumpIsSearchedForOnTheFrameItHappens) {
     } else {
       EXPECT_TRUE(jump.searched);
       EXPECT_EQ(jump.frame.status, TrackStatus::kReacquired);
-      // Tolerance: 1 cm and 3 deg, as the other re-acquisition tests.
-      EXPECT_LT(translation_error(jump.frame.object_to_camera, away), 0.01);
-      EXPECT_LT(rotation_error_deg(jump.frame.object_to_camera, away), 3.0);
+      expect_found_at(jump, away);
     }
   }
 }
@@ -482,9 +487,7 @@ TEST(TrackingSession, AWashedOutJumpIsTakenWhenItBeatsTheHeldPoseByTheMargin) {
       EXPECT_GT(translation_error(jump.frame.object_to_camera, away), 0.05) << "no jump: no test";
     } else {
       EXPECT_TRUE(jump.searched);
-      // Tolerance: 1 cm and 3 deg, as the other re-acquisition tests.
-      EXPECT_LT(translation_error(jump.frame.object_to_camera, away), 0.01);
-      EXPECT_LT(rotation_error_deg(jump.frame.object_to_camera, away), 3.0);
+      expect_found_at(jump, away);
       EXPECT_LT(jump.color.contrast, params.color_accept_ratio * level)
           << "taken by the accept ratio, not the margin: no test";
     }
@@ -533,9 +536,7 @@ TEST(TrackingSession, ATrackHeldOnTheBackgroundIsSearchedForBeforeTheLoss) {
     } else {
       ASSERT_TRUE(found.searched);
       EXPECT_EQ(found.frame.status, TrackStatus::kReacquired);
-      // Tolerance: 1 cm and 3 deg, as the other re-acquisition tests.
-      EXPECT_LT(translation_error(found.frame.object_to_camera, away), 0.01);
-      EXPECT_LT(rotation_error_deg(found.frame.object_to_camera, away), 3.0);
+      expect_found_at(found, away);
     }
   }
 }
