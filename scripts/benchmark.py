@@ -51,6 +51,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_strict_reanchor", "realtime", {"redetect_max_reprojection_increase_px": "0.5"}),
     # no search of image-plane shifts when KLT fails (the optimizer's basin only)
     ("realtime_no_shift_search", "realtime", {"shift_search_diameters": "0"}),
+    # ... that search scoring every shift of its grid (not every second, then around the best)
+    ("realtime_every_shift", "realtime", {"shift_search_coarse_to_fine": "false"}),
     # re-acquisition takes only placements above color_accept_ratio (no two-frame confirmation)
     ("realtime_no_confirm", "realtime", {"color_confirm_ratio": "0"}),
     # the colour verdict of a loss taken even while the contour energy or KLT says the pose holds

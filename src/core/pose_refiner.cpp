@@ -24,6 +24,9 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kGradientStepPx = 0.5;
 // Huber threshold of the keypoint cue, in units of keypoint_sigma_px (ours).
 constexpr double kKeypointHuberSigmas = 2.0;
+// shift_search_coarse_to_fine: how many of the best coarse shifts get their full-grid
+// neighbours scored (ours).
+constexpr std::size_t kShiftSearchRefined = 8;
 
 }  // namespace
 
@@ -308,23 +311,65 @@ bool PoseRefiner::search_shift(const Pose& preliminary, int level, Pose* shifted
   // A shift must clearly beat staying put (kMinGain x the energy): the object leaving the
   // image or an occluder's edge otherwise lure the pose to whatever edges are near.
   constexpr double kMinGain = 1.5;
-  std::vector<Eigen::Vector3d> shifts;
-  for (int j = -steps; j <= steps; ++j)
-    for (int i = -steps; i <= steps; ++i) {
-      if ((i == 0 && j == 0) || i * i + j * j > steps * steps) continue;
-      shifts.emplace_back(i * step_px * center_camera.z() / camera.fx(),
-                          j * step_px * center_camera.z() / camera.fy(), 0.0);
-    }
+  // Grid shift (i, j) steps: (i, j) = (0, 0) is staying put.
+  const auto in_disc = [steps](int i, int j) {
+    return !(i == 0 && j == 0) && i * i + j * j <= steps * steps;
+  };
+  const auto shift_of = [&](int i, int j) {
+    return Eigen::Vector3d(i * step_px * center_camera.z() / camera.fx(),
+                           j * step_px * center_camera.z() / camera.fy(), 0.0);
+  };
+  // Scored shifts in the order scored; a shift that keeps too few of the points in the image
+  // (or the gradients' region of interest) is not comparable.
+  std::vector<Eigen::Vector2i> grid;
+  std::vector<double> energies;
   std::vector<int> counts;
-  const std::vector<double> energies = contour_cost_->shifted_energies(preliminary, shifts, &counts);
+  const auto score = [&](const std::vector<Eigen::Vector2i>& cells) {
+    std::vector<Eigen::Vector3d> shifts;
+    for (const Eigen::Vector2i& cell : cells) shifts.push_back(shift_of(cell.x(), cell.y()));
+    std::vector<int> cell_counts;
+    const std::vector<double> cell_energies =
+        contour_cost_->shifted_energies(preliminary, shifts, &cell_counts);
+    grid.insert(grid.end(), cells.begin(), cells.end());
+    energies.insert(energies.end(), cell_energies.begin(), cell_energies.end());
+    counts.insert(counts.end(), cell_counts.begin(), cell_counts.end());
+  };
+  const auto comparable = [&](std::size_t s) { return counts[s] >= 0.7 * base_count; };
+  const int stride = params_.shift_search_coarse_to_fine && steps >= 2 ? 2 : 1;
+  std::vector<Eigen::Vector2i> cells;
+  for (int j = -steps; j <= steps; ++j)
+    for (int i = -steps; i <= steps; ++i)
+      if (in_disc(i, j) && i % stride == 0 && j % stride == 0) cells.emplace_back(i, j);
+  score(cells);
+  if (stride > 1) {
+    // The full grid's neighbours of the best coarse shifts (staying put is one of them: its
+    // neighbours too, a small move is the likeliest).
+    std::vector<std::size_t> order;
+    for (std::size_t s = 0; s < energies.size(); ++s)
+      if (comparable(s)) order.push_back(s);
+    const std::size_t keep = std::min<std::size_t>(kShiftSearchRefined, order.size());
+    std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(keep), order.end(),
+                      [&](std::size_t a, std::size_t b) { return energies[a] > energies[b]; });
+    std::vector<Eigen::Vector2i> centres{Eigen::Vector2i::Zero()};
+    for (std::size_t k = 0; k < keep; ++k) centres.push_back(grid[order[k]]);
+    std::vector<Eigen::Vector2i> fine;
+    for (const Eigen::Vector2i& centre : centres)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const Eigen::Vector2i cell(centre.x() + di, centre.y() + dj);
+          if (!in_disc(cell.x(), cell.y()) || (cell.x() % 2 == 0 && cell.y() % 2 == 0) ||
+              std::find(fine.begin(), fine.end(), cell) != fine.end())
+            continue;
+          fine.push_back(cell);
+        }
+    score(fine);
+  }
   double best_energy = kMinGain * base_energy;
   Eigen::Vector3d best_shift = Eigen::Vector3d::Zero();
-  for (std::size_t s = 0; s < shifts.size(); ++s) {
-    // A shift that keeps too few of the points in the image (or the gradients' region of
-    // interest) is not comparable.
-    if (counts[s] < 0.7 * base_count || !(energies[s] > best_energy)) continue;
+  for (std::size_t s = 0; s < grid.size(); ++s) {
+    if (!comparable(s) || !(energies[s] > best_energy)) continue;
     best_energy = energies[s];
-    best_shift = shifts[s];
+    best_shift = shift_of(grid[s].x(), grid[s].y());
   }
   if (best_shift.isZero()) return false;
   *shifted = preliminary;

@@ -85,11 +85,20 @@ TEST_F(PoseRefinerTest, ShiftSearchFindsAnObjectThatMovedFarWhenKltFailed) {
   // Tolerance: the test is meaningful only if the search is needed (the pose stays > 2 cm off).
   EXPECT_GT(translation_error(stuck.object_to_camera, truth_), 0.02);
   params.shift_search_diameters = 0.8;
-  PoseRefiner with(mesh_, params);
-  const RefineResult found = with.refine(gray_, camera_, stale, nullptr);
-  // Tolerance: 3 mm and 2 deg (coarse-to-fine accuracy on a 0.45 m distant box).
-  EXPECT_LT(translation_error(found.object_to_camera, truth_), 0.003);
-  EXPECT_LT(rotation_error_deg(found.object_to_camera, truth_), 2.0);
+  // Every shift scored, and every second one then the neighbours of the best (the preset's).
+  for (const bool coarse_to_fine : {false, true}) {
+    SCOPED_TRACE(coarse_to_fine ? "coarse to fine" : "every shift");
+    params.shift_search_coarse_to_fine = coarse_to_fine;
+    PoseRefiner with(mesh_, params);
+    // Also a move the other way, to an odd cell of the search grid.
+    for (const Pose& start :
+         {stale, test::move(truth_, 0.0, {0, 0, 1}, {-0.3 * size * 0.6, 0.3 * size * 0.8, 0})}) {
+      const RefineResult found = with.refine(gray_, camera_, start, nullptr);
+      // Tolerance: 3 mm and 2 deg (coarse-to-fine accuracy on a 0.45 m distant box).
+      EXPECT_LT(translation_error(found.object_to_camera, truth_), 0.003);
+      EXPECT_LT(rotation_error_deg(found.object_to_camera, truth_), 2.0);
+    }
+  }
 }
 
 TEST_F(PoseRefinerTest, ShiftSearchKeepsAPoseThatIsAlreadyRight) {

@@ -121,7 +121,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 102u);
+  EXPECT_EQ(fields.size(), 103u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
