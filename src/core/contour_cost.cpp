@@ -342,17 +342,6 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
   }
   for (std::size_t k = 0; k < samples_.size(); ++k)
     samples[k] = projected(object_to_camera * samples_[k], project);
-  // The innermost loop runs up to ~1300 x kMaxSamples times per call (the refiner's hottest
-  // loop while the track is lost): cell_at(), bilinear() and Hidden are written out here with
-  // the region's bounds and the image rows hoisted, in the same arithmetic (the same results).
-  const cv::Rect& roi = images.roi;
-  const double u_min = roi.x + 1.0, v_min = roi.y + 1.0;
-  const double u_max = roi.x + roi.width - 2.0, v_max = roi.y + roi.height - 2.0;
-  const int x_last = roi.width - 2, y_last = roi.height - 2;
-  const float* gx_data = images.gx.ptr<float>(0);
-  const float* gy_data = images.gy.ptr<float>(0);
-  const std::size_t gx_step = images.gx.step1(), gy_step = images.gy.step1();
-  const bool masked = !frame_->occlusion_mask.empty();
   for (std::size_t s = 0; s < shifts_camera.size(); ++s) {
     const double du = project.fx * shifts_camera[s].x(), dv = project.fy * shifts_camera[s].y();
     double sum = 0.0;
@@ -367,30 +356,15 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
       const double length = d.norm();
       if (!(length > 1e-9) || !std::isfinite(length)) continue;
       const Eigen::Vector2d normal = Eigen::Vector2d(-d.y(), d.x()) / length;
-      const double nx = normal.x(), ny = normal.y();
       const Segment& segment = segments_[i];
       for (int k = segment.first_sample; k < segment.end_sample; ++k) {
         const Projected& q = samples[static_cast<std::size_t>(k)];
-        if (!q.in_front) continue;
-        const double u = q.u + du * q.inv_z, v = q.v + dv * q.inv_z;
-        if (!(u >= u_min && v >= v_min && u <= u_max && v <= v_max)) continue;
         Cell c;
-        const double lu = u - roi.x, lv = v - roi.y;
-        c.x0 = std::min(static_cast<int>(lu), x_last);
-        c.y0 = std::min(static_cast<int>(lv), y_last);
-        c.ax = lu - c.x0;
-        c.ay = lv - c.y0;
-        if (masked && hidden(roi, c)) continue;
-        const float* x0 = gx_data + static_cast<std::size_t>(c.y0) * gx_step + c.x0;
-        const float* x1 = x0 + gx_step;
-        const float* y0 = gy_data + static_cast<std::size_t>(c.y0) * gy_step + c.x0;
-        const float* y1 = y0 + gy_step;
-        const double gx_top = x0[0] + c.ax * (x0[1] - x0[0]);
-        const double gx_bottom = x1[0] + c.ax * (x1[1] - x1[0]);
-        const double gy_top = y0[0] + c.ax * (y0[1] - y0[0]);
-        const double gy_bottom = y1[0] + c.ax * (y1[1] - y1[0]);
-        sum += std::abs((gx_top + c.ay * (gx_bottom - gx_top)) * nx +
-                        (gy_top + c.ay * (gy_bottom - gy_top)) * ny);
+        if (!q.in_front || !cell_at(q.u + du * q.inv_z, q.v + dv * q.inv_z, images.roi, &c) ||
+            hidden(images.roi, c))
+          continue;
+        sum += std::abs(bilinear(images.gx, c.x0, c.y0, c.ax, c.ay) * normal.x() +
+                        bilinear(images.gy, c.x0, c.y0, c.ax, c.ay) * normal.y());
         ++kept;
       }
     }

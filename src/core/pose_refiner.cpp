@@ -336,10 +336,11 @@ bool PoseRefiner::search_shift(const Pose& preliminary, int level, Pose* shifted
   };
   const auto comparable = [&](std::size_t s) { return counts[s] >= 0.7 * base_count; };
   const int stride = params_.shift_search_coarse_to_fine && steps >= 2 ? 2 : 1;
+  const auto on_coarse_grid = [stride](int i, int j) { return i % stride == 0 && j % stride == 0; };
   std::vector<Eigen::Vector2i> cells;
   for (int j = -steps; j <= steps; ++j)
     for (int i = -steps; i <= steps; ++i)
-      if (in_disc(i, j) && i % stride == 0 && j % stride == 0) cells.emplace_back(i, j);
+      if (in_disc(i, j) && on_coarse_grid(i, j)) cells.emplace_back(i, j);
   score(cells);
   if (stride > 1) {
     // The full grid's neighbours of the best coarse shifts (staying put is one of them: its
@@ -357,7 +358,7 @@ bool PoseRefiner::search_shift(const Pose& preliminary, int level, Pose* shifted
       for (int dj = -1; dj <= 1; ++dj)
         for (int di = -1; di <= 1; ++di) {
           const Eigen::Vector2i cell(centre.x() + di, centre.y() + dj);
-          if (!in_disc(cell.x(), cell.y()) || (cell.x() % 2 == 0 && cell.y() % 2 == 0) ||
+          if (!in_disc(cell.x(), cell.y()) || on_coarse_grid(cell.x(), cell.y()) ||
               std::find(fine.begin(), fine.end(), cell) != fine.end())
             continue;
           fine.push_back(cell);
