@@ -341,7 +341,10 @@ class Runner:
             % (label, name, frames, want))
         return False
 
-    def track(self, section, config, name, folder, model, max_frames=None, model_scale=None, score_model=None):
+    def track(self, section, config, name, folder, model, max_frames=None, model_scale=None, score_model=None,
+              hypotheses=False):
+        """hypotheses: also write the colour searches' refined hypotheses (track_sequence
+        --hypotheses) to the summary's "hypotheses_file" (dev_loop.py reach)."""
         label, preset, params = config
         out = os.path.join(self.results, section, label)
         os.makedirs(out, exist_ok=True)
@@ -362,12 +365,14 @@ class Runner:
             cmd += ["--param", "%s=%s" % (k, v)]
         if max_frames:
             cmd += ["--max-frames", str(max_frames)]
+        if hypotheses:
+            cmd += ["--hypotheses", base + ".hypotheses.csv"]
         t0 = time.time()
         if label in self.reuse and os.path.exists(base + ".json") and \
                 self.reusable(base + ".json", folder, max_frames, label, name):
             pass  # --reuse: the previous run's result of this configuration
         else:
-            for f in (base + ".json", base + ".errors.txt", base + ".trace.csv"):
+            for f in (base + ".json", base + ".errors.txt", base + ".trace.csv", base + ".hypotheses.csv"):
                 if os.path.exists(f):
                     os.remove(f)
             proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -379,6 +384,8 @@ class Runner:
                                       datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")))
         with open(base + ".json") as f:
             summary = json.load(f)
+        if hypotheses:
+            summary["hypotheses_file"] = base + ".hypotheses.csv"
         summary["errors"] = []
         if os.path.exists(base + ".errors.txt"):
             with open(base + ".errors.txt") as f:

@@ -9,8 +9,10 @@ generates them, or `dev_loop.py generate` under the built workspace's environmen
   dev_loop.py generate                                   # the hard sets and their noise draws
   dev_loop.py run LABEL [--binary PATH] [--draws 0,1] [--sets hard] [--objects can,toy]
                   [--conditions occlusion] [--preset realtime] [--jobs 2] [--mismatch]
-                  [--param NAME=VALUE ...] [--camera-rate 30]
+                  [--param NAME=VALUE ...] [--camera-rate 30] [--hypotheses]
   dev_loop.py compare CANDIDATE BASE                      # paired per draw, per condition, runs
+  dev_loop.py reach LABEL                                 # a --hypotheses run: what re-acquisition
+                                                          # had to choose from, against the truth
 
 Runs are written under $KCT_DATA/benchmark/dev/LABEL/ (poses, errors, trace, summary per run)
 and $KCT_DATA/benchmark/dev/LABEL.json (the scored rows)."""
@@ -66,13 +68,13 @@ def run(a):
         source = os.path.join(DATA, s, o, c)
         folder = B.perturbed_sequence(DATA, source, s, o, c, d)
         r = runner.track("dev", (a.label, a.preset, params), "%s/%s/%s/d%d" % (s, o, c, d), folder,
-                         models[o][0], score_model=models[o][1])
+                         models[o][0], score_model=models[o][1], hypotheses=a.hypotheses)
         if not r:  # Runner logged the failure
             return None
         B.score_visible(r, source)
         return dict(draw=d, set=s, object=o, condition=c, auc=r["auc"], scored_frames=r["scored_frames"],
                     diameter_m=r["diameter_m"], errors=r["errors"], states=r["states"],
-                    visible_errors=r["visible_errors"])
+                    visible_errors=r["visible_errors"], hypotheses_file=r.get("hypotheses_file"))
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
         rows = [r for r in ex.map(one, jobs) if r]
     json.dump(dict(label=a.label, binary=a.binary, preset=a.preset, params=a.params, mismatch=a.mismatch,
@@ -128,6 +130,61 @@ def compare(a):
     return 0
 
 
+def reach(a):
+    """How far the re-acquisition's hypotheses reach: over the frames that re-acquire (the state
+    is lost) with the object visible (the benchmark's HARD_MIN_VISIBLE), the frames where a
+    refined hypothesis is right (error < WRONG_POSE_DIAMETERS, the "re-acquired right" measure),
+    where the search chose a right one, where one is at the right place (centre within that
+    share of the diameter), where the chosen one is, and how far the ones at the right place
+    are turned. The choice can do no better than the first count."""
+    rows = json.load(open(os.path.join(DEV, a.label + ".json")))["rows"]
+    if not any(r.get("hypotheses_file") for r in rows):
+        print("%s: no hypotheses recorded (run it with --hypotheses)" % a.label, file=sys.stderr)
+        return 1
+    limit = B.WRONG_POSE_DIAMETERS
+    counts = {}
+    turns = []
+    for r in rows:
+        path = r.get("hypotheses_file")
+        if not path or not os.path.exists(path):
+            continue
+        frames = {}
+        with open(path) as f:
+            header = f.readline().strip().split(",")
+            for line in f:
+                h = dict(zip(header, line.strip().split(",")))
+                i = int(h["frame"])
+                if h["reacquiring"] != "1" or not h["error_diameters"] or \
+                        i >= len(r["visible_errors"]) or r["visible_errors"][i] is None:
+                    continue
+                frames.setdefault(i, []).append(h)
+        cell = counts.setdefault(r["condition"], [0] * 5)
+        for hs in frames.values():
+            right = [float(h["error_diameters"]) < limit for h in hs]
+            placed = [float(h["centre_diameters"]) < limit for h in hs]
+            chosen = [h["chosen"] == "1" for h in hs]
+            cell[0] += 1
+            cell[1] += any(right)
+            cell[2] += any(x and c for x, c in zip(right, chosen))
+            cell[3] += any(placed)
+            cell[4] += any(x and c for x, c in zip(placed, chosen))
+            turns += [float(h["rotation_deg"]) for h, x in zip(hs, placed) if x]
+    print("%s: frames that re-acquire with the object visible; of them, a right hypothesis "
+          "(error < %.2f diameters) / chosen right / one at the right place (centre < %.2f) / "
+          "chosen there" % (a.label, limit, limit))
+    total = [0] * 5
+    for c in B.HARD_CONDITIONS:
+        if c in counts:
+            print("  %-10s %5d  right %4d  chosen right %4d  placed %4d  chosen placed %4d" % ((c,) + tuple(counts[c])))
+            total = [t + x for t, x in zip(total, counts[c])]
+    print("  %-10s %5d  right %4d  chosen right %4d  placed %4d  chosen placed %4d" % (("all",) + tuple(total)))
+    if turns:
+        turns.sort()
+        print("  turn of the hypotheses at the right place: median %.1f deg, quartiles %.1f-%.1f" % (
+            turns[len(turns) // 2], turns[len(turns) // 4], turns[3 * len(turns) // 4]))
+    return 0
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
@@ -148,11 +205,15 @@ def main():
                    help="replay as a live camera at HZ (frames dropped while busy); 0: every frame")
     r.add_argument("--param", action="append", default=[], dest="params", metavar="NAME=VALUE",
                    help="a track_sequence --param override (repeat for several)")
+    r.add_argument("--hypotheses", action="store_true",
+                   help="also record the colour searches' refined hypotheses (for reach)")
     c = sub.add_parser("compare")
     c.add_argument("candidate")
     c.add_argument("base")
+    h = sub.add_parser("reach")
+    h.add_argument("label")
     a = p.parse_args()
-    return {"generate": generate, "run": run, "compare": compare}[a.command](a) or 0
+    return {"generate": generate, "run": run, "compare": compare, "reach": reach}[a.command](a) or 0
 
 
 if __name__ == "__main__":

@@ -56,6 +56,7 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
   const auto startup = std::chrono::steady_clock::now();
   TrackingSession session(std::move(mesh), params, options.quality);
   session.set_camera(run.camera);
+  session.set_record_hypotheses(options.record_hypotheses);
   run.startup_ms = elapsed_ms(startup);
   session.initialize(sequence.poses.front());
   Pose last = sequence.poses.front();

@@ -251,6 +251,18 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       if (scored[i].contrast > scored[best_index].contrast &&
           within_reach(refined_poses[i], reach_px))
         best_index = i;
+    if (record_hypotheses_)
+      for (std::size_t i = 0; i < refined.size(); ++i) {
+        HypothesisRecord record;
+        record.start_object_to_camera = hypotheses[i];
+        record.object_to_camera = refined_poses[i];
+        record.contrast = scored[i].contrast;
+        record.energy = refined[i].energy_after;
+        record.in_reach = i == 0 || within_reach(refined_poses[i], reach_px);
+        record.chosen = i == best_index;
+        record.reacquiring = monitor_.should_reacquire();
+        frame_hypotheses_.push_back(record);
+      }
     TrackResult best = refined[best_index];
     const double best_contrast = scored[best_index].contrast;
     // color_confirm_ratio: a weaker best hypothesis counts when the previous frame's best was at
@@ -701,6 +713,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   result.reacquiring = monitor_.should_reacquire();
   if (!result.reacquiring) unconfirmed_.reset();
   frame_search_ = FrameSearch();
+  frame_hypotheses_.clear();
   // The colour frame, when the colour model is on and the frame is in colour (checked first:
   // an invalid frame is the tracker's to report).
   cv::Mat bgr;
@@ -770,6 +783,8 @@ SessionResult TrackingSession::track(const Frame& frame) {
       frames_since_learning_ = 0;
     }
   }
+  result.hypotheses = std::move(frame_hypotheses_);
+  frame_hypotheses_.clear();
   // The whole call: tracking, checks, colour search and learning.
   result.frame.frame_time_ms = elapsed_ms(start);
   count(result);

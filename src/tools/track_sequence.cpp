@@ -5,7 +5,8 @@
 //   track_sequence --sequence DIR --model MESH [--model-scale S] [--preset NAME]
 //                  [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]
 //                  [--max-frames N] [--max-image-pixels N] [--errors FILE] [--score-model MESH]
-//                  [--debug-dir DIR [--debug-every N]] [--camera-rate HZ] [--quiet]
+//                  [--debug-dir DIR [--debug-every N]] [--trace FILE] [--hypotheses FILE]
+//                  [--camera-rate HZ] [--quiet]
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -36,6 +37,7 @@ void usage(const char* error) {
                "                      [--max-frames N] [--max-image-pixels N] [--errors FILE]\n"
                "                      [--score-model MESH]\n"
                "                      [--debug-dir DIR [--debug-every N]] [--trace FILE]\n"
+               "                      [--hypotheses FILE]\n"
                "                      [--camera-rate HZ] [--quiet]\n"
                "  --quality NAME=VALUE: the session's loss / recovery thresholds, as the nodelet's\n"
                "  parameters of the same names (lost_after_bad_frames, recover_after_good_frames,\n"
@@ -56,6 +58,11 @@ void usage(const char* error) {
                "  --trace FILE writes one CSV line per frame: status, state, quality, KLT tracked / inliers,\n"
                "  energy before / after / level, colour contrast / level, searched, colour visible fraction,\n"
                "  relocalized, rotation corrected (why a track was lost or kept).\n"
+               "  --hypotheses FILE writes one CSV line per hypothesis a colour search refined: the frame,\n"
+               "  whether the frame re-acquires, its colour contrast and contour energy, in reach, chosen,\n"
+               "  and with ground truth for the frame its error delta_i, centre distance (both in object\n"
+               "  diameters) and rotation error (deg) after and before the refinement (how far the\n"
+               "  re-acquisition's hypotheses reach; scripts/dev_loop.py reach sums them up).\n"
                "  --camera-rate HZ: replay as a live camera at HZ: a frame that a newer one replaced\n"
                "  while the tracker was busy (its wall time here) is dropped, as the nodelet's one-message\n"
                "  queue drops it, and holds the last pose (scored so; no trace or debug line). Timing-\n"
@@ -70,7 +77,8 @@ void usage(const char* error) {
 }
 
 struct Options {
-  std::string sequence, model, preset = "realtime", output, summary_json, errors, debug_dir, trace;
+  std::string sequence, model, preset = "realtime", output, summary_json, errors, debug_dir, trace,
+      hypotheses;
   std::string score_model;  ///< the object's true shape for scoring; empty = `model`
   int debug_every = 1;
   double model_scale = 1.0;
@@ -109,6 +117,7 @@ Options parse(int argc, char** argv) {
          {"--debug-dir", store(o.debug_dir)},
          {"--debug-every", store(o.debug_every)},
          {"--trace", store(o.trace)},
+         {"--hypotheses", store(o.hypotheses)},
          {"--camera-rate", store(o.camera_rate_hz)},
          {"--param", [&o](const std::string& kv) { o.overrides.push_back(name_value(kv)); }},
          {"--quality", [&o](const std::string& kv) {
@@ -186,6 +195,7 @@ int main(int argc, char** argv) {
     run_options.max_image_pixels = options.max_image_pixels;
     run_options.quality = options.quality;
     run_options.camera_rate_hz = options.camera_rate_hz;
+    run_options.record_hypotheses = !options.hypotheses.empty();
     size_t frames = sequence.image_paths.size();
     if (options.max_frames > 0) frames = std::min(frames, static_cast<size_t>(options.max_frames));
     // Per-stage times of the tracked frames (not the first), for the benchmark's stage table.
@@ -205,8 +215,37 @@ int main(int argc, char** argv) {
       trace << "frame,status,state,quality,good,klt_tracked,klt_inliers,energy_before,energy_after,"
                "energy_level,color_contrast,color_level,searched,color_visible,relocalized,rotation_corrected,texture_corrected,texture_correlation,frame_ms\n";
     }
+    std::ofstream hypotheses;
+    if (!options.hypotheses.empty()) {
+      hypotheses.open(options.hypotheses);
+      if (!hypotheses) throw std::runtime_error(options.hypotheses + ": cannot write");
+      hypotheses << "frame,reacquiring,index,contrast,energy,in_reach,chosen,error_diameters,"
+                    "centre_diameters,rotation_deg,start_error_diameters,start_centre_diameters,"
+                    "start_rotation_deg\n";
+    }
+    const double score_diameter_m = score_mesh->diameter();
     run_options.on_frame = [&](size_t i, const cv::Mat& image, const kct::SessionResult& result,
                                const kct::TrackingSession& session) {
+      if (hypotheses.is_open()) {
+        // Against the frame's ground truth (pose.txt's line i), when there is one.
+        const bool truth = sequence.poses.size() >= 2 && i < sequence.poses.size();
+        const Eigen::Vector3d& center = session.tracker().center_object();
+        const auto errors = [&](const kct::Pose& pose) {
+          if (!truth) return std::string(",,");
+          const kct::Pose& t = sequence.poses[i];
+          return cv::format("%.4f,%.4f,%.2f",
+                            kct::mean_vertex_distance(score_mesh->vertices, pose, t) / score_diameter_m,
+                            ((pose * center) - (t * center)).norm() / score_diameter_m,
+                            kct::rotation_error_deg(pose, t));
+        };
+        for (size_t k = 0; k < result.hypotheses.size(); ++k) {
+          const kct::HypothesisRecord& h = result.hypotheses[k];
+          hypotheses << i << ',' << (h.reacquiring ? 1 : 0) << ',' << k << ','
+                     << cv::format("%.4f,%.4g,%d,%d,", h.contrast, h.energy, h.in_reach ? 1 : 0,
+                                   h.chosen ? 1 : 0)
+                     << errors(h.object_to_camera) << ',' << errors(h.start_object_to_camera) << '\n';
+        }
+      }
       if (i > 0 && result.frame.status != kct::TrackStatus::kInvalidInput)
         for (size_t k = 0; k < stages.size(); ++k)
           stage_ms[k].push_back(result.frame.times.*(stages[k].second));

@@ -370,6 +370,68 @@ TEST(TrackingSession, ColourSearchReacquiresAnObjectThatReappearsFarAway) {
   }
 }
 
+/// set_record_hypotheses: the red box of the test above is hidden until lost and shown again
+/// 12 cm away. Recording lists every hypothesis the re-acquiring searches refined, exactly one
+/// chosen per search, the chosen one of the best colour contrast among those in reach, and one of
+/// them on the box; and it changes nothing of the tracking (the same poses with it off, when
+/// nothing is listed).
+TEST(TrackingSession, RecordedHypothesesAreWhatTheSearchChoseFrom) {
+  const ColourScene scene;
+  const Pose away = test::move(scene.start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
+  TrackerParams params = quick_realtime();
+  params.feature_relocalization = false;
+  std::vector<std::vector<SessionResult>> runs;
+  for (const bool record : {false, true}) {
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.set_record_hypotheses(record);
+    session.initialize(scene.start);
+    std::vector<SessionResult> results;
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033)
+      results.push_back(session.track(
+          {test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp}));
+    for (int i = 0; i < 12; ++i, stamp += 0.033) results.push_back(session.track({scene.background.clone(), stamp}));
+    for (int i = 0; i < 6; ++i, stamp += 0.033)
+      results.push_back(session.track(
+          {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 50 + i), stamp}));
+    runs.push_back(results);
+  }
+  const auto& plain = runs[0];
+  const auto& recorded = runs[1];
+  ASSERT_EQ(plain.size(), recorded.size());
+  int searches = 0, on_the_box = 0;
+  for (std::size_t i = 0; i < recorded.size(); ++i) {
+    EXPECT_TRUE(plain[i].hypotheses.empty()) << i;
+    EXPECT_TRUE(plain[i].frame.object_to_camera.isApprox(recorded[i].frame.object_to_camera, 1e-12))
+        << "recording changed the track at frame " << i;
+    EXPECT_EQ(plain[i].state, recorded[i].state) << i;
+    const std::vector<HypothesisRecord>& h = recorded[i].hypotheses;
+    if (h.empty()) continue;
+    EXPECT_EQ(recorded[i].reacquiring, h.front().reacquiring) << i;
+    // One search's hypotheses: the last good pose first, then the others (a frame may hold two
+    // searches; each has its own chosen one).
+    int chosen = 0;
+    double best_in_reach = -1e9;
+    const HypothesisRecord* pick = nullptr;
+    for (const HypothesisRecord& r : h) {
+      chosen += r.chosen ? 1 : 0;
+      if (r.chosen) pick = &r;
+      if (r.in_reach) best_in_reach = std::max(best_in_reach, r.contrast);
+      if (translation_error(r.object_to_camera, away) < 0.01 &&
+          rotation_error_deg(r.object_to_camera, away) < 3.0)
+        ++on_the_box;
+    }
+    ASSERT_GE(chosen, 1) << i;
+    ++searches;
+    if (chosen == 1) {
+      EXPECT_DOUBLE_EQ(pick->contrast, best_in_reach) << i;
+    }
+  }
+  EXPECT_GT(searches, 0) << "no search recorded: the test shows nothing";
+  EXPECT_GT(on_the_box, 0) << "no recorded hypothesis on the box that came back";
+}
+
 /// color_search_reach_diameters: the red box is hidden until the session declares it lost, then
 /// comes back 2 cm from where it was, its middle covered by a bar, while a whole twin stands 17 cm
 /// away on the other side (the better colour match). Searching the whole frame takes the twin;

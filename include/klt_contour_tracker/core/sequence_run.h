@@ -38,6 +38,9 @@ struct SequenceRunOptions {
   /// Called after every frame: its index, the decoded image (empty when the frame could not be
   /// read), the session's result and the session.
   std::function<void(std::size_t, const cv::Mat&, const SessionResult&, const TrackingSession&)> on_frame;
+  /// TrackingSession::set_record_hypotheses: on_frame's results list the colour searches'
+  /// refined hypotheses.
+  bool record_hypotheses = false;
 };
 
 /// Outcome of track_sequence_folder().

@@ -24,6 +24,20 @@
 namespace kct {
 
 /// What one TrackingSession::track() call did.
+/// One hypothesis a colour search refined on a frame (TrackingSession::set_record_hypotheses):
+/// what the re-acquisition had to choose from, for measuring how far its hypotheses reach.
+struct HypothesisRecord {
+  Pose start_object_to_camera;  ///< where its refinement started, metres
+  Pose object_to_camera;        ///< the refined pose, metres
+  double contrast = 0.0;        ///< colour contrast of the refined pose (ObjectSearch::score)
+  double energy = 0.0;          ///< contour energy after the refinement
+  bool in_reach = true;         ///< within color_search_reach_diameters (only those can win)
+  bool chosen = false;          ///< the search's best: the pose it takes if it passes its bar
+  /// A search of a frame that re-acquires (SessionResult::reacquiring), not a check of a
+  /// tracked pose (extrapolated_search_ratio / tracked_search_ratio).
+  bool reacquiring = false;
+};
+
 struct SessionResult {
   /// The pipeline's result (poses in metres); its frame_time_ms is the wall time of the whole
   /// TrackingSession::track() call.
@@ -49,6 +63,9 @@ struct SessionResult {
   /// fewer than SurfaceTexture::kMinPoints learned points face the camera there.
   double texture_correlation = std::numeric_limits<double>::quiet_NaN();
   ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
+  /// With set_record_hypotheses(true): every hypothesis the colour searches of this frame
+  /// refined, in their order (a frame can be searched twice); empty otherwise.
+  std::vector<HypothesisRecord> hypotheses;
   bool time_jumped_back = false;  ///< the frame's stamp is earlier than the previous frame's
   bool restarted = false;    ///< ... and the session restarted from restart_pose()
   /// True unless the status is kNotInitialized or kInvalidInput.
@@ -129,6 +146,9 @@ class TrackingSession {
   /// Validate and replace the parameters (std::invalid_argument); keep the track.
   void set_params(const TrackerParams& params);
   void set_quality_params(const TrackQualityParams& quality);
+  /// Report the colour searches' refined hypotheses in SessionResult::hypotheses (a
+  /// measurement aid: track_sequence --hypotheses; the tracking itself does not change).
+  void set_record_hypotheses(bool record) { record_hypotheses_ = record; }
 
   const SessionStatistics& statistics() const { return statistics_; }
   void clear_statistics() { statistics_ = {}; }
@@ -241,6 +261,8 @@ class TrackingSession {
     std::vector<TrackResult> refined;    ///< ... and their refinements
   };
   FrameSearch frame_search_;
+  bool record_hypotheses_ = false;                 ///< see set_record_hypotheses()
+  std::vector<HypothesisRecord> frame_hypotheses_;  ///< this frame's, when recorded
   /// While LOST, the previous frame's re-acquired pose (repeat_recover_diameters), if it was one.
   std::optional<Pose> previous_find_;
   /// repeat_recover_diameters: whether `result` (this frame's) was re-acquired where the previous
