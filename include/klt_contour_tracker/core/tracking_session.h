@@ -23,12 +23,11 @@
 
 namespace kct {
 
-/// What one TrackingSession::track() call did.
 /// One hypothesis a colour search refined on a frame (TrackingSession::set_record_hypotheses):
 /// what the re-acquisition had to choose from, for measuring how far its hypotheses reach.
 struct HypothesisRecord {
-  Pose start_object_to_camera;  ///< where its refinement started, metres
-  Pose object_to_camera;        ///< the refined pose, metres
+  Pose start_object_to_camera = Pose::Identity();  ///< where its refinement started, metres
+  Pose object_to_camera = Pose::Identity();        ///< the refined pose, metres
   double contrast = 0.0;        ///< colour contrast of the refined pose (ObjectSearch::score)
   double energy = 0.0;          ///< contour energy after the refinement
   bool in_reach = true;         ///< within color_search_reach_diameters (only those can win)
@@ -38,6 +37,7 @@ struct HypothesisRecord {
   bool reacquiring = false;
 };
 
+/// What one TrackingSession::track() call did.
 struct SessionResult {
   /// The pipeline's result (poses in metres); its frame_time_ms is the wall time of the whole
   /// TrackingSession::track() call.
