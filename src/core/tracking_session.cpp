@@ -246,11 +246,10 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     const std::vector<SearchCandidate> scored = search_->score(bgr, refined_poses, camera);
     // A hypothesis the refinement took out of reach is not a candidate (the last good pose,
     // the first, is the fallback).
+    const auto candidate = [&](std::size_t i) { return i == 0 || within_reach(refined_poses[i], reach_px); };
     std::size_t best_index = 0;
     for (std::size_t i = 1; i < scored.size(); ++i)
-      if (scored[i].contrast > scored[best_index].contrast &&
-          within_reach(refined_poses[i], reach_px))
-        best_index = i;
+      if (scored[i].contrast > scored[best_index].contrast && candidate(i)) best_index = i;
     if (record_hypotheses_)
       for (std::size_t i = 0; i < refined.size(); ++i) {
         HypothesisRecord record;
@@ -258,7 +257,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
         record.object_to_camera = refined_poses[i];
         record.contrast = scored[i].contrast;
         record.energy = refined[i].energy_after;
-        record.in_reach = i == 0 || within_reach(refined_poses[i], reach_px);
+        record.in_reach = candidate(i);
         record.chosen = i == best_index;
         record.reacquiring = monitor_.should_reacquire();
         frame_hypotheses_.push_back(record);
@@ -783,8 +782,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
       frames_since_learning_ = 0;
     }
   }
-  result.hypotheses = std::move(frame_hypotheses_);
-  frame_hypotheses_.clear();
+  result.hypotheses = std::move(frame_hypotheses_);  // cleared again when the next frame starts
   // The whole call: tracking, checks, colour search and learning.
   result.frame.frame_time_ms = elapsed_ms(start);
   count(result);
