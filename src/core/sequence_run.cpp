@@ -61,6 +61,12 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
   session.initialize(sequence.poses.front());
   Pose last = sequence.poses.front();
   run.dropped.assign(frames, 0);
+  if (options.refine_truth) {
+    TrackResult not_refined;
+    not_refined.status = TrackStatus::kNotInitialized;
+    run.truth_refined.assign(frames, not_refined);
+  }
+  const bool has_truth = sequence.poses.size() >= 2;
   // camera_rate_hz: when the session is next free, s (frame 0 arrives at 0).
   double free_at_s = 0.0;
   const auto arrival_s = [&](std::size_t i) { return static_cast<double>(i) / options.camera_rate_hz; };
@@ -86,6 +92,8 @@ SequenceRun track_sequence_folder(const SequenceFolder& sequence, std::shared_pt
       result = session.track({image, static_cast<double>(i)});
       busy_ms = elapsed_ms(started);
       if (result.frame.status == TrackStatus::kInvalidInput) error = path + ": " + result.frame.message;
+      else if (options.refine_truth && has_truth && i >= 1 && i < sequence.poses.size())
+        run.truth_refined[i] = session.refine_from({image, static_cast<double>(i)}, sequence.poses[i]);
     } else {
       result.frame.status = TrackStatus::kInvalidInput;
       result.frame.message = error;

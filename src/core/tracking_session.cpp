@@ -302,6 +302,15 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
 }
 
+TrackResult TrackingSession::refine_from(const Frame& frame, const Pose& start) {
+  if (!tracker_ || monitor_.state() == TrackState::kWaitingForPose) {
+    TrackResult none;
+    none.status = TrackStatus::kNotInitialized;
+    return none;
+  }
+  return tracker_->refine_hypotheses(frame, {start}, 1.0, false).front();
+}
+
 std::vector<TrackResult> TrackingSession::refine_once(const Frame& frame,
                                                      const std::vector<Pose>& hypotheses) {
   std::vector<TrackResult> refined(hypotheses.size());

@@ -6,6 +6,7 @@
 //                  [--param NAME=VALUE ...] [--output FILE] [--summary-json FILE]
 //                  [--max-frames N] [--max-image-pixels N] [--errors FILE] [--score-model MESH]
 //                  [--debug-dir DIR [--debug-every N]] [--trace FILE] [--hypotheses FILE]
+//                  [--truth-refinement FILE]
 //                  [--camera-rate HZ] [--quiet]
 #include <cstdio>
 #include <cstdlib>
@@ -37,7 +38,7 @@ void usage(const char* error) {
                "                      [--max-frames N] [--max-image-pixels N] [--errors FILE]\n"
                "                      [--score-model MESH]\n"
                "                      [--debug-dir DIR [--debug-every N]] [--trace FILE]\n"
-               "                      [--hypotheses FILE]\n"
+               "                      [--hypotheses FILE] [--truth-refinement FILE]\n"
                "                      [--camera-rate HZ] [--quiet]\n"
                "  --quality NAME=VALUE: the session's loss / recovery thresholds, as the nodelet's\n"
                "  parameters of the same names (lost_after_bad_frames, recover_after_good_frames,\n"
@@ -63,6 +64,11 @@ void usage(const char* error) {
                "  and with ground truth for the frame its error delta_i, centre distance (both in object\n"
                "  diameters) and rotation error (deg) after and before the refinement (how far the\n"
                "  re-acquisition's hypotheses reach; scripts/dev_loop.py reach sums them up).\n"
+               "  --truth-refinement FILE writes, for every tracked frame after the first with ground\n"
+               "  truth, the true pose refined as a re-acquisition hypothesis is (contour only, no\n"
+               "  keypoints, no shift search): contour energy at the truth and after, and how far the\n"
+               "  refinement moved it (error delta_i and centre distance in diameters, rotation deg,\n"
+               "  depth mm, + = farther). Whether the objective holds the truth; the track is unchanged.\n"
                "  --camera-rate HZ: replay as a live camera at HZ: a frame that a newer one replaced\n"
                "  while the tracker was busy (its wall time here) is dropped, as the nodelet's one-message\n"
                "  queue drops it, and holds the last pose (scored so; no trace or debug line). Timing-\n"
@@ -78,7 +84,7 @@ void usage(const char* error) {
 
 struct Options {
   std::string sequence, model, preset = "realtime", output, summary_json, errors, debug_dir, trace,
-      hypotheses;
+      hypotheses, truth_refinement;
   std::string score_model;  ///< the object's true shape for scoring; empty = `model`
   int debug_every = 1;
   double model_scale = 1.0;
@@ -118,6 +124,7 @@ Options parse(int argc, char** argv) {
          {"--debug-every", store(o.debug_every)},
          {"--trace", store(o.trace)},
          {"--hypotheses", store(o.hypotheses)},
+         {"--truth-refinement", store(o.truth_refinement)},
          {"--camera-rate", store(o.camera_rate_hz)},
          {"--param", [&o](const std::string& kv) { o.overrides.push_back(name_value(kv)); }},
          {"--quality", [&o](const std::string& kv) {
@@ -196,6 +203,7 @@ int main(int argc, char** argv) {
     run_options.quality = options.quality;
     run_options.camera_rate_hz = options.camera_rate_hz;
     run_options.record_hypotheses = !options.hypotheses.empty();
+    run_options.refine_truth = !options.truth_refinement.empty();
     size_t frames = sequence.image_paths.size();
     if (options.max_frames > 0) frames = std::min(frames, static_cast<size_t>(options.max_frames));
     // Per-stage times of the tracked frames (not the first), for the benchmark's stage table.
@@ -286,6 +294,23 @@ int main(int argc, char** argv) {
     if (!options.quiet) std::cerr << "\n";
     frames = run.object_to_camera.size();
     if (!options.output.empty()) kct::write_pose_file(options.output, run.object_to_camera, units);
+    if (!options.truth_refinement.empty()) {
+      std::ofstream out(options.truth_refinement);
+      if (!out) throw std::runtime_error(options.truth_refinement + ": cannot write");
+      out << "frame,energy_truth,energy_refined,error_diameters,centre_diameters,rotation_deg,depth_mm\n";
+      const Eigen::Vector3d center = mesh->bounding_box_center();
+      for (size_t i = 0; i < run.truth_refined.size(); ++i) {
+        const kct::TrackResult& r = run.truth_refined[i];
+        if (r.status != kct::TrackStatus::kReacquired) continue;  // not refined
+        const kct::Pose& t = sequence.poses[i];
+        const kct::Pose& p = r.object_to_camera;
+        out << i << ',' << cv::format("%.4g,%.4g,%.4f,%.4f,%.2f,%.2f\n", r.energy_before, r.energy_after,
+                                      kct::mean_vertex_distance(score_mesh->vertices, p, t) / score_diameter_m,
+                                      ((p * center) - (t * center)).norm() / score_diameter_m,
+                                      kct::rotation_error_deg(p, t),
+                                      ((p * center).z() - (t * center).z()) * 1000.0);
+      }
+    }
 
     const kct::SessionStatistics& stats = run.statistics;
     const double median_ms = kct::median(run.frame_ms), p90_ms = kct::percentile(run.frame_ms, 90),

@@ -41,6 +41,11 @@ struct SequenceRunOptions {
   /// TrackingSession::set_record_hypotheses: on_frame's results list the colour searches'
   /// refined hypotheses.
   bool record_hypotheses = false;
+  /// A measurement aid: after each tracked frame with ground truth (sequence.poses[i], i >= 1
+  /// and more than one pose), its true pose refined by TrackingSession::refine_from() into
+  /// SequenceRun::truth_refined (does the refinement's objective hold the truth?). The track
+  /// does not change; the time is not counted in the frame's.
+  bool refine_truth = false;
 };
 
 /// Outcome of track_sequence_folder().
@@ -59,6 +64,9 @@ struct SequenceRun {
   /// the cache), ms; what a nodelet spends before its first frame.
   double startup_ms = 0.0;
   PinholeCamera camera;                   ///< from K.txt and the first frame's size
+  /// refine_truth: per frame, the true pose refined (status kNotInitialized where it was not:
+  /// no ground truth, the first frame, a dropped or unusable frame).
+  std::vector<TrackResult> truth_refined;
 };
 
 /// Tracks `sequence` (poses in metres: read_sequence() converted them) from its first pose with

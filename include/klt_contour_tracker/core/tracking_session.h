@@ -149,6 +149,13 @@ class TrackingSession {
   /// Report the colour searches' refined hypotheses in SessionResult::hypotheses (a
   /// measurement aid: track_sequence --hypotheses; the tracking itself does not change).
   void set_record_hypotheses(bool record) { record_hypotheses_ = record; }
+  /// A measurement aid (track_sequence --truth-refinement): `start` refined on `frame` (the
+  /// frame track() was just given) as a re-acquisition hypothesis is refined there: the
+  /// contour refinement alone, without keypoints or the shift search. From the true pose it
+  /// shows whether the refinement's objective holds the truth. The track does not change (only
+  /// the refiner's per-call state is used). An invalid result (status kInvalidInput or
+  /// kNotInitialized) when there is no camera or track yet, or the frame is unusable.
+  TrackResult refine_from(const Frame& frame, const Pose& start);
 
   const SessionStatistics& statistics() const { return statistics_; }
   void clear_statistics() { statistics_ = {}; }
