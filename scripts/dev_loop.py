@@ -13,6 +13,8 @@ generates them, or `dev_loop.py generate` under the built workspace's environmen
   dev_loop.py compare CANDIDATE BASE                      # paired per draw, per condition, runs
   dev_loop.py reach LABEL                                 # a --hypotheses run: what re-acquisition
                                                           # had to choose from, against the truth
+  dev_loop.py truth [--binary PATH] [--sets hard,hard2] [--objects ...] [--conditions ...]
+                                                          # does the refinement hold the true pose?
 
 Runs are written under $KCT_DATA/benchmark/dev/LABEL/ (poses, errors, trace, summary per run)
 and $KCT_DATA/benchmark/dev/LABEL.json (the scored rows)."""
@@ -185,6 +187,56 @@ def reach(a):
     return 0
 
 
+def truth(a):
+    """Does the refinement's objective hold the truth? Every frame's true pose refined as a
+    re-acquisition hypothesis is (track_sequence --truth-refinement: contour only, no keypoints,
+    no shift search), on the sets' unperturbed sequences, over the frames with at least half the
+    object visible: how far the refinement moves it, per condition and per object. A pose that
+    leaves the truth where the objective is flat or biased cannot be held by the refinement alone
+    (the keypoints must), and a hypothesis that starts there is not refined to it."""
+    import subprocess
+    import tempfile
+    import statistics
+    cells = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for s in a.sets.split(","):
+            for o in a.objects.split(","):
+                model = os.path.join(DATA, "models", B.HARD_OBJECTS[o]["model"] + ".obj")
+                for c in a.conditions.split(","):
+                    folder = os.path.join(DATA, s, o, c)
+                    out = os.path.join(tmp, "%s_%s_%s.csv" % (s, o, c))
+                    subprocess.run([a.binary, "--sequence", folder, "--model", model, "--preset", a.preset,
+                                    "--truth-refinement", out, "--quiet"], check=True,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                    visible = [float(x) for x in open(os.path.join(folder, "visible.txt"))
+                               if x.strip() and not x.startswith("#")]
+                    with open(out) as f:
+                        header = f.readline().strip().split(",")
+                        for line in f:
+                            h = dict(zip(header, line.strip().split(",")))
+                            i = int(h["frame"])
+                            if i >= len(visible) or visible[i] < 0.5:
+                                continue
+                            gain = float(h["energy_refined"]) / float(h["energy_truth"]) if float(h["energy_truth"]) > 0 else 1.0
+                            row = (abs(float(h["depth_mm"])), float(h["rotation_deg"]), float(h["error_diameters"]), gain)
+                            for key in (c, o, "all"):
+                                cells.setdefault(key, []).append(row)
+    print("the true pose refined (contour only), frames with >= half the object visible: median |depth| mm, "
+          "median / 90th-percentile rotation deg, share turned > 5 deg, share still right (error < %.2f "
+          "diameters), median energy gain" % B.WRONG_POSE_DIAMETERS)
+    for key in a.conditions.split(",") + a.objects.split(",") + ["all"]:
+        rows = cells.get(key)
+        if not rows:
+            continue
+        rot = sorted(r[1] for r in rows)
+        print("  %-10s %5d  |depth| %5.1f  rotation %5.2f / %5.1f  > 5 deg %3.0f %%  right %3.0f %%  gain %.3f" % (
+            key, len(rows), statistics.median(r[0] for r in rows), statistics.median(rot), rot[int(0.9 * (len(rot) - 1))],
+            100.0 * sum(x > 5.0 for x in rot) / len(rot),
+            100.0 * sum(r[2] < B.WRONG_POSE_DIAMETERS for r in rows) / len(rows),
+            statistics.median(r[3] for r in rows)))
+    return 0
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
@@ -212,8 +264,14 @@ def main():
     c.add_argument("base")
     h = sub.add_parser("reach")
     h.add_argument("label")
+    t = sub.add_parser("truth")
+    t.add_argument("--binary", default=r.get_default("binary"))
+    t.add_argument("--sets", default=",".join(B.HARD_SETS))
+    t.add_argument("--objects", default=",".join(B.HARD_OBJECTS))
+    t.add_argument("--conditions", default=",".join(B.HARD_CONDITIONS))
+    t.add_argument("--preset", default="realtime")
     a = p.parse_args()
-    return {"generate": generate, "run": run, "compare": compare, "reach": reach}[a.command](a) or 0
+    return {"generate": generate, "run": run, "compare": compare, "reach": reach, "truth": truth}[a.command](a) or 0
 
 
 if __name__ == "__main__":
