@@ -232,19 +232,22 @@ int main(int argc, char** argv) {
                     "start_rotation_deg\n";
     }
     const double score_diameter_m = score_mesh->diameter();
+    // A pose against a true one: error delta_i and centre distance (object diameters, against
+    // the scored shape) and rotation (deg), as "e,c,r" (--hypotheses, --truth-refinement).
+    const Eigen::Vector3d center = mesh->bounding_box_center();  // the tracker's centre_object
+    const auto pose_errors = [&](const kct::Pose& pose, const kct::Pose& t) {
+      return cv::format("%.4f,%.4f,%.2f",
+                        kct::mean_vertex_distance(score_mesh->vertices, pose, t) / score_diameter_m,
+                        ((pose * center) - (t * center)).norm() / score_diameter_m,
+                        kct::rotation_error_deg(pose, t));
+    };
     run_options.on_frame = [&](size_t i, const cv::Mat& image, const kct::SessionResult& result,
                                const kct::TrackingSession& session) {
       if (hypotheses.is_open()) {
         // Against the frame's ground truth (pose.txt's line i), when there is one.
         const bool truth = sequence.poses.size() >= 2 && i < sequence.poses.size();
-        const Eigen::Vector3d& center = session.tracker().center_object();
         const auto errors = [&](const kct::Pose& pose) {
-          if (!truth) return std::string(",,");
-          const kct::Pose& t = sequence.poses[i];
-          return cv::format("%.4f,%.4f,%.2f",
-                            kct::mean_vertex_distance(score_mesh->vertices, pose, t) / score_diameter_m,
-                            ((pose * center) - (t * center)).norm() / score_diameter_m,
-                            kct::rotation_error_deg(pose, t));
+          return truth ? pose_errors(pose, sequence.poses[i]) : std::string(",,");
         };
         for (size_t k = 0; k < result.hypotheses.size(); ++k) {
           const kct::HypothesisRecord& h = result.hypotheses[k];
@@ -298,17 +301,13 @@ int main(int argc, char** argv) {
       std::ofstream out(options.truth_refinement);
       if (!out) throw std::runtime_error(options.truth_refinement + ": cannot write");
       out << "frame,energy_truth,energy_refined,error_diameters,centre_diameters,rotation_deg,depth_mm\n";
-      const Eigen::Vector3d center = mesh->bounding_box_center();
       for (size_t i = 0; i < run.truth_refined.size(); ++i) {
         const kct::TrackResult& r = run.truth_refined[i];
         if (r.status != kct::TrackStatus::kReacquired) continue;  // not refined
         const kct::Pose& t = sequence.poses[i];
         const kct::Pose& p = r.object_to_camera;
-        out << i << ',' << cv::format("%.4g,%.4g,%.4f,%.4f,%.2f,%.2f\n", r.energy_before, r.energy_after,
-                                      kct::mean_vertex_distance(score_mesh->vertices, p, t) / score_diameter_m,
-                                      ((p * center) - (t * center)).norm() / score_diameter_m,
-                                      kct::rotation_error_deg(p, t),
-                                      ((p * center).z() - (t * center).z()) * 1000.0);
+        out << i << ',' << cv::format("%.4g,%.4g,", r.energy_before, r.energy_after) << pose_errors(p, t)
+            << cv::format(",%.2f\n", ((p * center).z() - (t * center).z()) * 1000.0);
       }
     }
 
