@@ -235,11 +235,17 @@ def first_frames_auc(rows, n):
     return auc([e / r["diameter_m"] for r in rows for e in r["visible_errors"][:n] if e is not None], 1.0)
 
 
+def read_visible(folder):
+    """`folder`'s visible.txt: per frame, the fraction of the object's silhouette in the image
+    and not occluded (comment lines skipped)."""
+    return [float(l) for l in open(os.path.join(folder, "visible.txt")) if not l.startswith("#")]
+
+
 def score_visible(row, source):
     """Scores a tracked hard-style run `row` (Runner.track's summary) on the frames where at least
     HARD_MIN_VISIBLE of the object is seen (`source`'s visible.txt): sets its auc, scored_frames
     and visible_errors (metres, None where not scored); returns the visible fractions."""
-    visible = [float(l) for l in open(os.path.join(source, "visible.txt")) if not l.startswith("#")]
+    visible = read_visible(source)
     scored = [e for e, v in zip(row["errors"], visible) if v >= HARD_MIN_VISIBLE]
     row.update(auc=auc(scored, row["diameter_m"]), scored_frames=len(scored),
                visible_errors=[(e if v >= HARD_MIN_VISIBLE else None) for e, v in zip(row["errors"], visible)])

@@ -208,8 +208,7 @@ def truth(a):
                     subprocess.run([a.binary, "--sequence", folder, "--model", model, "--preset", a.preset,
                                     "--truth-refinement", out, "--quiet"], check=True,
                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-                    visible = [float(x) for x in open(os.path.join(folder, "visible.txt"))
-                               if x.strip() and not x.startswith("#")]
+                    visible = B.read_visible(folder)
                     with open(out) as f:
                         header = f.readline().strip().split(",")
                         for line in f:
