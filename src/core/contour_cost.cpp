@@ -90,10 +90,11 @@ Projected projected(const Eigen::Vector3d& x, const Projection& project) {
 }  // namespace
 
 ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, double spacing_px,
-                         double blur_sigma_px, int num_threads)
+                         double blur_sigma_px, int num_threads, double chroma_weight)
     : extractor_(std::move(extractor)),
       spacing_px_(spacing_px),
       blur_sigma_px_(blur_sigma_px),
+      chroma_weight_(chroma_weight),
       edge_width_px_(std::sqrt(blur_sigma_px * blur_sigma_px + 1.0)) {
   if (!extractor_) throw std::invalid_argument("ContourCost: extractor is null");
   center_object_ = extractor_->mesh().bounding_box_center();
@@ -104,6 +105,9 @@ ContourCost::ContourCost(std::shared_ptr<const ContourExtractor> extractor, doub
   if (!(blur_sigma_px >= 0.0 && blur_sigma_px <= 20.0))
     throw std::invalid_argument("ContourCost: blur_sigma_px must be in [0, 20], got " +
                                 std::to_string(blur_sigma_px));
+  if (!(chroma_weight >= 0.0) || !std::isfinite(chroma_weight))
+    throw std::invalid_argument("ContourCost: chroma_weight must be >= 0 and finite, got " +
+                                std::to_string(chroma_weight));
   if (num_threads < 1)
     throw std::invalid_argument("ContourCost: num_threads must be >= 1, got " +
                                 std::to_string(num_threads));
@@ -148,7 +152,8 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
   bool same = levels_.size() == frame.levels.size() && levels_source_.size() == frame.levels.size();
   for (std::size_t l = 0; same && l < rois.size(); ++l)
     same = levels_source_[l].data == frame.levels[l].gray.data &&
-           levels_source_[l].size() == frame.levels[l].gray.size() && levels_[l].roi == rois[l];
+           levels_source_[l].size() == frame.levels[l].gray.size() && levels_[l].roi == rois[l] &&
+           levels_[l].chroma_gx[0].empty() == (chroma_level(static_cast<int>(l)) != static_cast<int>(l));
   if (same) return;
   levels_source_.clear();
   levels_.assign(frame.levels.size(), LevelImages());
@@ -163,23 +168,56 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
     const int pad = static_cast<int>(std::ceil(3.0 * blur_sigma_px_)) + 2;
     const cv::Rect outer = cv::Rect(roi.x - pad, roi.y - pad, roi.width + 2 * pad,
                                     roi.height + 2 * pad) & bounds;
-    cv::Mat image;
-    level.gray(outer).convertTo(image, CV_32F);
-    if (blur_sigma_px_ > 0.0)
-      cv::GaussianBlur(image, image, cv::Size(), blur_sigma_px_, blur_sigma_px_,
-                       cv::BORDER_REPLICATE);
-    cv::Mat gx, gy;
-    // Sobel 3x3 / 8: a ramp of slope s gives s (as GradientImage::compute).
-    cv::Sobel(image, gx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
-    cv::Sobel(image, gy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
     const cv::Rect inner(roi.x - outer.x, roi.y - outer.y, roi.width, roi.height);
-    out.gx = gx(inner);
-    out.gy = gy(inner);
+    // Blurred, then Sobel 3x3 / 8: a ramp of slope s gives s (as GradientImage::compute).
+    const auto derivatives = [&](const cv::Mat& source, double scale, cv::Mat* dx, cv::Mat* dy) {
+      cv::Mat image;
+      source.convertTo(image, CV_32F);
+      if (blur_sigma_px_ > 0.0)
+        cv::GaussianBlur(image, image, cv::Size(), blur_sigma_px_, blur_sigma_px_,
+                         cv::BORDER_REPLICATE);
+      cv::Mat gx, gy;
+      cv::Sobel(image, gx, CV_32F, 1, 0, 3, scale / 8.0, 0.0, cv::BORDER_REPLICATE);
+      cv::Sobel(image, gy, CV_32F, 0, 1, 3, scale / 8.0, 0.0, cv::BORDER_REPLICATE);
+      *dx = gx(inner);
+      *dy = gy(inner);
+    };
+    derivatives(level.gray(outer), 1.0, &out.gx, &out.gy);
     cv::Mat magnitude;
     cv::magnitude(out.gx, out.gy, magnitude);
-    out.contrast = std::max(1e-3, kContrastFactor * cv::mean(magnitude)[0]);
+    out.contrast = kContrastFactor * cv::mean(magnitude)[0];
+    if (chroma_level(l) == l) {
+      // Only the region's chromaticity is computed; both channels are filtered in one call.
+      cv::Mat gx2, gy2;
+      derivatives(chromaticity(level.bgr(outer)), chroma_weight_, &gx2, &gy2);
+      cv::split(gx2, out.chroma_gx);
+      cv::split(gy2, out.chroma_gy);
+      for (int k = 0; k < 2; ++k) {
+        cv::Mat chroma_magnitude;
+        cv::magnitude(out.chroma_gx[k], out.chroma_gy[k], chroma_magnitude);
+        out.chroma_contrast += kContrastFactor * cv::mean(chroma_magnitude)[0];
+      }
+    }
   });
+  // The contrast scale covers every channel the level reads (its chromaticity's, in this
+  // level's px, where it reads a coarser level's).
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
+    const int at = chroma_level(static_cast<int>(l));
+    if (at >= 0)
+      levels_[l].contrast += levels_[at].chroma_contrast * frame.levels[at].scale / frame.levels[l].scale;
+    levels_[l].contrast = std::max(1e-3, levels_[l].contrast);
+  }
   for (const PyramidLevel& level : frame.levels) levels_source_.push_back(level.gray);
+}
+
+int ContourCost::chroma_level(int level) const {
+  if (!(chroma_weight_ > 0.0) || !frame_ || level < 0 ||
+      level >= static_cast<int>(frame_->levels.size()))
+    return -1;
+  // Colour cameras and their streams carry the chroma at half the resolution (Bayer mosaic,
+  // YUV 4:2:0, JPEG): the full-resolution level reads it from the next coarser one.
+  const int at = level == 0 && frame_->levels.size() > 1 ? 1 : level;
+  return frame_->levels[at].bgr.empty() ? -1 : at;
 }
 
 double ContourCost::contrast_scale() const {
@@ -261,6 +299,10 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
   perp << 0.0, -1.0, 1.0, 0.0;
 
   const Hidden hidden(frame_->occlusion_mask, frame_->levels[level_].scale);
+  const int chroma_at = chroma_level(level_);
+  const LevelImages* chroma = chroma_at >= 0 ? &levels_[chroma_at] : nullptr;
+  const double to_chroma =
+      chroma ? frame_->levels[chroma_at].scale / frame_->levels[level_].scale : 1.0;
   double sum = 0.0;
   int kept = 0;
   for (const Segment& segment : segments_) {
@@ -279,24 +321,49 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
       const Eigen::Vector3d x = r * samples_[k] + t;
       Cell c;
       if (!cell_of(x, project, images.roi, &c) || hidden(images.roi, c)) continue;
-      const int x0 = c.x0, y0 = c.y0;
-      const double ax = c.ax, ay = c.ay;
-      const Eigen::Vector2d g(bilinear(images.gx, x0, y0, ax, ay),
-                              bilinear(images.gy, x0, y0, ax, ay));
-      const double along = g.dot(normal);
-      const double value = std::abs(along);
+      // Each channel's |g . n|: the grey one at (x0, y0) and, when used, the two chromaticity
+      // ones read on their own level (`scale` its px per this level's px: a gradient there is
+      // scale x one here, and its derivative scale^2 x).
+      const cv::Mat* channel_gx[3] = {&images.gx, nullptr, nullptr};
+      const cv::Mat* channel_gy[3] = {&images.gy, nullptr, nullptr};
+      Cell cells[3] = {c, c, c};
+      double scale[3] = {1.0, 1.0, 1.0};
+      int channels = 1;
+      if (chroma) {
+        const Eigen::Vector2d p = project(x);
+        if (cell_at(p.x() * to_chroma, p.y() * to_chroma, chroma->roi, &cells[1])) {
+          for (int k = 0; k < 2; ++k) {
+            channel_gx[1 + k] = &chroma->chroma_gx[k];
+            channel_gy[1 + k] = &chroma->chroma_gy[k];
+            cells[1 + k] = cells[1];
+            scale[1 + k] = to_chroma;
+          }
+          channels = 3;
+        }
+      }
+      double value = 0.0;
+      const Matrix26d jp = derivatives ? projection_jacobian(x, center_camera, fx, fy) : Matrix26d();
+      for (int ch = 0; ch < channels; ++ch) {
+        const cv::Mat& cgx = *channel_gx[ch];
+        const cv::Mat& cgy = *channel_gy[ch];
+        const Cell& cell = cells[ch];
+        const Eigen::Vector2d g = scale[ch] * Eigen::Vector2d(bilinear(cgx, cell.x0, cell.y0, cell.ax, cell.ay),
+                                                              bilinear(cgy, cell.x0, cell.y0, cell.ax, cell.ay));
+        const double along = g.dot(normal);
+        value += std::abs(along);
+        if (!gradient) continue;
+        // d(g . n)/dp = n^T dg/dp, dg/dp the exact derivative of the bilinear interpolation.
+        const double s2 = scale[ch] * scale[ch];
+        const Eigen::Vector2d dgx = s2 * bilinear_derivative(cgx, cell.x0, cell.y0, cell.ax, cell.ay);
+        const Eigen::Vector2d dgy = s2 * bilinear_derivative(cgy, cell.x0, cell.y0, cell.ax, cell.ay);
+        const Eigen::RowVector2d dvalue_dp(normal.x() * dgx.x() + normal.y() * dgy.x(),
+                                           normal.x() * dgx.y() + normal.y() * dgy.y());
+        const double sign = along >= 0.0 ? 1.0 : -1.0;
+        *gradient += sign * (dvalue_dp * jp + g.transpose() * normal_jacobian).transpose();
+      }
       sum += value;
       ++kept;
       if (!derivatives) continue;
-      // d(g . n)/dp = n^T dg/dp, dg/dp the exact derivative of the bilinear interpolation.
-      const Eigen::Vector2d dgx = bilinear_derivative(images.gx, x0, y0, ax, ay);
-      const Eigen::Vector2d dgy = bilinear_derivative(images.gy, x0, y0, ax, ay);
-      const Eigen::RowVector2d dvalue_dp(normal.x() * dgx.x() + normal.y() * dgy.x(),
-                                         normal.x() * dgx.y() + normal.y() * dgy.y());
-      const Matrix26d jp = projection_jacobian(x, center_camera, fx, fy);
-      const double sign = along >= 0.0 ? 1.0 : -1.0;
-      if (gradient)
-        *gradient += sign * (dvalue_dp * jp + g.transpose() * normal_jacobian).transpose();
       if (hessian) {
         const Eigen::Matrix<double, 1, 6> along_normal = normal.transpose() * jp;
         *hessian += (value * inv_sigma2) * along_normal.transpose() * along_normal;
@@ -335,6 +402,10 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
   const PinholeCamera& camera = frame_->levels[level_].camera;
   const Projection project{camera.fx(), camera.fy(), camera.cx(), camera.cy()};
   const Hidden hidden(frame_->occlusion_mask, frame_->levels[level_].scale);
+  const int chroma_at = chroma_level(level_);
+  const LevelImages* chroma = chroma_at >= 0 ? &levels_[chroma_at] : nullptr;
+  const double to_chroma =
+      chroma ? frame_->levels[chroma_at].scale / frame_->levels[level_].scale : 1.0;
   std::vector<Projected> ends(2 * segments_.size()), samples(samples_.size());
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     ends[2 * i] = projected(object_to_camera * segments_[i].a_object, project);
@@ -365,6 +436,13 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
           continue;
         sum += std::abs(bilinear(images.gx, c.x0, c.y0, c.ax, c.ay) * normal.x() +
                         bilinear(images.gy, c.x0, c.y0, c.ax, c.ay) * normal.y());
+        Cell cc;
+        if (chroma && cell_at((q.u + du * q.inv_z) * to_chroma, (q.v + dv * q.inv_z) * to_chroma,
+                              chroma->roi, &cc))
+          for (int k = 0; k < 2; ++k)
+            sum += to_chroma *
+                   std::abs(bilinear(chroma->chroma_gx[k], cc.x0, cc.y0, cc.ax, cc.ay) * normal.x() +
+                            bilinear(chroma->chroma_gy[k], cc.x0, cc.y0, cc.ax, cc.ay) * normal.y());
         ++kept;
       }
     }

@@ -43,18 +43,45 @@ Matrix26d projection_jacobian(const Eigen::Vector3d& point_camera,
   return j;
 }
 
+cv::Mat chromaticity(const cv::Mat& bgr) {
+  if (bgr.empty() || bgr.type() != CV_8UC3)
+    throw std::invalid_argument("chromaticity: bgr must be a non-empty CV_8UC3 image");
+  constexpr float kDarkOffset = 30.0f;  // intensity units added to r + g + b
+  // One pass per pixel (it runs on every frame's region at every pyramid level; a chain of
+  // whole-image OpenCV operations makes a dozen passes).
+  const float k1 = static_cast<float>(255.0 / std::sqrt(2.0));
+  const float k2 = static_cast<float>(255.0 / std::sqrt(6.0));
+  cv::Mat chroma(bgr.size(), CV_32FC2);
+  for (int v = 0; v < bgr.rows; ++v) {
+    const cv::Vec3b* in = bgr.ptr<cv::Vec3b>(v);
+    cv::Vec2f* out = chroma.ptr<cv::Vec2f>(v);
+    for (int u = 0; u < bgr.cols; ++u) {
+      const float b = in[u][0], g = in[u][1], r = in[u][2];
+      const float inverse_intensity = 1.0f / (r + g + b + kDarkOffset);
+      out[u] = cv::Vec2f(k1 * (r - g) * inverse_intensity, k2 * (r + g - 2.0f * b) * inverse_intensity);
+    }
+  }
+  return chroma;
+}
+
 std::vector<PyramidLevel> make_pyramid(const cv::Mat& gray, const PinholeCamera& camera,
-                                       int levels) {
+                                       int levels, const cv::Mat& bgr) {
   if (gray.empty() || gray.type() != CV_8UC1)
     throw std::invalid_argument("make_pyramid: gray must be a non-empty CV_8UC1 image");
   if (levels < 1) throw std::invalid_argument("make_pyramid: levels must be >= 1");
+  if (!bgr.empty() && bgr.size() != gray.size())
+    throw std::invalid_argument("make_pyramid: bgr and gray differ in size");
   std::vector<PyramidLevel> pyramid(levels);
   pyramid[0].gray = gray;
+  if (!bgr.empty() && bgr.type() != CV_8UC3)
+    throw std::invalid_argument("make_pyramid: bgr must be CV_8UC3");
+  pyramid[0].bgr = bgr;
   pyramid[0].camera = camera;
   pyramid[0].scale = 1.0;
   for (int l = 1; l < levels; ++l) {
     // cv::pyrDown keeps pixel centres at integer coordinates: level pixel u maps to 2 u below.
     cv::pyrDown(pyramid[l - 1].gray, pyramid[l].gray);
+    if (!pyramid[l - 1].bgr.empty()) cv::pyrDown(pyramid[l - 1].bgr, pyramid[l].bgr);
     const double s = pyramid[l - 1].scale * 0.5;
     pyramid[l].scale = s;
     pyramid[l].camera = PinholeCamera(camera.fx() * s, camera.fy() * s, camera.cx() * s,

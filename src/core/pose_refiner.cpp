@@ -61,7 +61,8 @@ std::unique_ptr<PoseRefiner> PoseRefiner::replica() const {
 
 void PoseRefiner::build_cues() {
   contour_cost_ = std::make_shared<ContourCost>(extractor_, params_.contour_sample_spacing_px,
-                                                params_.blur_sigma_px, params_.num_threads);
+                                                params_.blur_sigma_px, params_.num_threads,
+                                                params_.contour_chroma_weight);
   keypoint_cost_ = std::make_shared<KeypointCost>(
       params_.keypoint_sigma_px, kKeypointHuberSigmas * params_.keypoint_sigma_px);
   costs_.clear();
@@ -90,13 +91,16 @@ void PoseRefiner::prepare_frame(const cv::Mat& gray, const PinholeCamera& camera
   // pyramid is kept. The levels hold the frame's buffer, so it cannot be another frame's.
   std::vector<PyramidLevel> levels;
   const PinholeCamera& kept = cost_frame_.levels.empty() ? camera : cost_frame_.levels[0].camera;
+  // The colour levels are made when the contour cue reads their chromaticity.
+  const cv::Mat chroma_source = params_.contour_chroma_weight > 0.0 ? bgr : cv::Mat();
   if (static_cast<int>(cost_frame_.levels.size()) == params_.pyramid_levels &&
       cost_frame_.levels[0].gray.data == gray.data &&
+      cost_frame_.levels[0].bgr.empty() == chroma_source.empty() &&
       cost_frame_.levels[0].gray.size() == gray.size() && kept.fx() == camera.fx() &&
       kept.fy() == camera.fy() && kept.cx() == camera.cx() && kept.cy() == camera.cy())
     levels = std::move(cost_frame_.levels);
   else
-    levels = make_pyramid(gray, camera, params_.pyramid_levels);
+    levels = make_pyramid(gray, camera, params_.pyramid_levels, chroma_source);
   cost_frame_ = PoseCostFrame();
   cost_frame_.levels = std::move(levels);
   cost_frame_.predicted_object_to_camera = cost_frame_.preliminary_object_to_camera = predicted;

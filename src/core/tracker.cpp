@@ -261,6 +261,8 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
   // The frame is converted once for every hypothesis; the search box is widened once.
   const bool refine = params_.refine && refiner_;
   const cv::Mat gray = refine ? to_gray(frame.image) : cv::Mat();
+  // The colour frame, when the contour energy uses its chromaticity (empty for grey frames).
+  const cv::Mat bgr = refine && params_.contour_chroma_weight > 0.0 ? to_bgr(frame.image) : cv::Mat();
   TrackerParams widened = params_;
   widened.extrapolated_rotation_bound_deg =
       std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);
@@ -280,7 +282,9 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
       TrackResult& result = results[i];
       result.status = TrackStatus::kReacquired;
       result.object_to_camera = result.preliminary_object_to_camera = around[i];
-      if (refiner) apply_refinement(refiner->refine(gray, camera_, around[i], nullptr), result);
+      if (!refiner) continue;
+      if (!bgr.empty()) refiner->prepare_frame(gray, camera_, around[i], bgr);
+      apply_refinement(refiner->refine(gray, camera_, around[i], nullptr), result);
     }
   };
   try {
@@ -339,7 +343,9 @@ TrackResult Tracker::track(const Frame& frame) {
   }
   const cv::Mat gray = to_gray(frame.image);
   // The region cue's colour frame (ours): learned from at trusted poses, scored in refine().
-  const cv::Mat bgr = region_cost_ ? to_bgr(frame.image) : cv::Mat();
+  // The contour energy's chromaticity (ours) reads it as well.
+  const cv::Mat bgr =
+      region_cost_ || params_.contour_chroma_weight > 0.0 ? to_bgr(frame.image) : cv::Mat();
 
   if (state_ == State::kPendingFirstFrame) {
     detect_keypoints(gray, result);

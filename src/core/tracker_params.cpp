@@ -58,7 +58,9 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(occlusion_mask_frames),
       KCT_FIELD(refine), KCT_FIELD(sharp_edge_angle_deg), KCT_FIELD(icosphere_subdivisions),
       KCT_FIELD(visibility_resolution_px), KCT_FIELD(visibility_cache_dir),
-      KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(final_hops),
+      KCT_FIELD(contour_sample_spacing_px), KCT_FIELD(blur_sigma_px), KCT_FIELD(contour_chroma_weight),
+      KCT_FIELD(contour_chroma_plain_only),
+      KCT_FIELD(final_hops),
       KCT_FIELD(hops_budget), KCT_FIELD(min_hops_cap), KCT_FIELD(max_hops_without_improvement_cap),
       KCT_FIELD(max_hops_cap), KCT_FIELD(max_reprojection_increase_px),
       KCT_FIELD(extrapolated_rotation_bound_deg), KCT_FIELD(extrapolated_axial_bound),
@@ -171,6 +173,7 @@ void TrackerParams::validate() const {
   check_range(kOwner, "visibility_resolution_px", visibility_resolution_px, 16, 4096);
   check_range(kOwner, "contour_sample_spacing_px", contour_sample_spacing_px, 0.1, 100.0);
   check_range(kOwner, "blur_sigma_px", blur_sigma_px, 0.0, 20.0);
+  check_range(kOwner, "contour_chroma_weight", contour_chroma_weight, 0.0, 10.0);
   check_range(kOwner, "final_hops", final_hops, 0, 10000);
   check_range(kOwner, "hops_budget", hops_budget, 1.0, 1e12);
   check_range(kOwner, "min_hops_cap", min_hops_cap, 0, 100000);

@@ -174,6 +174,7 @@ void TrackingSession::set_params(const TrackerParams& params) {
 TrackerParams TrackingSession::tracker_params() const {
   TrackerParams params = params_;
   if (plain_surface_) params.keypoint_weight *= params_.plain_surface_keypoint_scale;
+  if (params_.contour_chroma_plain_only && !plain_surface_) params.contour_chroma_weight = 0.0;
   return params;
 }
 
@@ -181,7 +182,9 @@ void TrackingSession::set_plain_surface(bool plain) {
   if (plain == plain_surface_) return;
   plain_surface_ = plain;
   // Only the refiner's cue weights change (Tracker::set_params keeps the track).
-  if (tracker_ && params_.plain_surface_keypoint_scale != 1.0) tracker_->set_params(tracker_params());
+  const bool changes = params_.plain_surface_keypoint_scale != 1.0 ||
+                       (params_.contour_chroma_plain_only && params_.contour_chroma_weight > 0.0);
+  if (tracker_ && changes) tracker_->set_params(tracker_params());
 }
 
 void TrackingSession::set_quality_params(const TrackQualityParams& quality) {

@@ -259,6 +259,106 @@ TEST_F(ContourCostTest, ResultDoesNotDependOnTheThreadCount) {
   }
 }
 
+TEST(Chromaticity, IgnoresShadingAndFollowsHue) {
+  // Orange at full and at 40 % brightness, and blue of the dark orange's grey level.
+  cv::Mat bgr(1, 3, CV_8UC3);
+  bgr.at<cv::Vec3b>(0, 0) = {20, 110, 220};
+  bgr.at<cv::Vec3b>(0, 1) = {8, 44, 88};
+  bgr.at<cv::Vec3b>(0, 2) = {110, 50, 20};
+  const cv::Mat chroma = chromaticity(bgr);
+  ASSERT_EQ(chroma.type(), CV_32FC2);
+  const cv::Vec2f bright = chroma.at<cv::Vec2f>(0, 0), dark = chroma.at<cv::Vec2f>(0, 1),
+                  blue = chroma.at<cv::Vec2f>(0, 2);
+  // The shading moves it by the dark offset's share only (< 20 % here); the hue by > 100.
+  EXPECT_LT(cv::norm(bright - dark), 0.2 * cv::norm(bright));
+  EXPECT_GT(cv::norm(dark - blue), 100.0);
+  // Grey has none.
+  const cv::Mat grey(2, 2, CV_8UC3, cv::Scalar(90, 90, 90));
+  EXPECT_LT(cv::norm(chromaticity(grey), cv::NORM_INF), 1e-4);
+  EXPECT_THROW(chromaticity(cv::Mat(2, 2, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
+}
+
+/// An orange box whose shading darkens over the last 6 px inside its outline (a curved
+/// object's rim), on a blue background of the dark rim's grey level: the outline is an edge
+/// of colour only, the strongest grey edge is inside the object.
+class ShadedRimTest : public ContourCostTest {
+ protected:
+  void SetUp() override {
+    ContourCostTest::SetUp();
+    const cv::Mat mask = renderer_.render(truth_, camera_).mask();
+    cv::Mat inside;
+    cv::distanceTransform(mask, inside, cv::DIST_L2, 3);
+    cv::Mat bgr(camera_.size(), CV_8UC3, cv::Scalar(110, 50, 20));
+    for (int v = 0; v < bgr.rows; ++v)
+      for (int u = 0; u < bgr.cols; ++u)
+        if (mask.at<uchar>(v, u)) {
+          const double shade = 0.4 + 0.6 * std::min(1.0, (inside.at<float>(v, u) - 1.0) / 6.0);
+          bgr.at<cv::Vec3b>(v, u) = cv::Vec3b(cv::saturate_cast<uchar>(20 * shade),
+                                              cv::saturate_cast<uchar>(110 * shade),
+                                              cv::saturate_cast<uchar>(220 * shade));
+        }
+    cv::Mat gray;
+    cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+    gray_ = gray;
+    shaded_.levels = make_pyramid(gray_, camera_, 3, bgr);
+    shaded_.predicted_object_to_camera = shaded_.preliminary_object_to_camera = truth_;
+    shaded_.center_object = frame_.center_object;
+  }
+  /// The energy at the true pose and at the pose 4 % farther (its outline ~3 px inside).
+  std::pair<double, double> truth_and_farther(double chroma_weight) {
+    ContourCost cost(extractor_, 2.0, 1.0, 1, chroma_weight);
+    cost.begin_frame(shaded_);
+    cost.linearize(truth_, 0);
+    Pose farther = truth_;
+    farther.translation() *= 1.04;
+    return {cost.energy(truth_), cost.energy(farther)};
+  }
+  cv::Mat gray_;
+  PoseCostFrame shaded_;
+};
+
+TEST_F(ShadedRimTest, GreyEdgesPullTheOutlineInsideAndChromaticityHoldsIt) {
+  const auto [grey_truth, grey_farther] = truth_and_farther(0.0);
+  EXPECT_GT(grey_farther, grey_truth);  // the bias this cue is for
+  const auto [chroma_truth, chroma_farther] = truth_and_farther(1.0);
+  EXPECT_GT(chroma_truth, 1.1 * chroma_farther);
+  // Grey levels alone (no colour frame given): the weight changes nothing.
+  PoseCostFrame grey_only = shaded_;
+  grey_only.levels = make_pyramid(gray_, camera_, 3);
+  ContourCost plain(extractor_, 2.0, 1.0), weighted(extractor_, 2.0, 1.0, 1, 1.0);
+  plain.begin_frame(grey_only);
+  weighted.begin_frame(grey_only);
+  plain.linearize(truth_, 0);
+  weighted.linearize(truth_, 0);
+  EXPECT_EQ(plain.energy(truth_), weighted.energy(truth_));
+}
+
+TEST_F(ShadedRimTest, AnalyticGradientWithChromaticityMatchesNumericOnEveryLevel) {
+  ContourCost cost(extractor_, 2.0, 1.0, 1, 1.0);
+  cost.begin_frame(shaded_);
+  const Pose pose = test::move(truth_, 1.0, {0.3, 1.0, -0.2}, {0.0015, -0.001, 0.002});
+  for (int level = 0; level < 3; ++level) {
+    cost.linearize(pose, level);
+    ASSERT_TRUE(cost.active());
+    Vector6d analytic = Vector6d::Zero();
+    cost.evaluate(pose, &analytic, nullptr);
+    const double px_m = 0.45 / (camera_.fx() * std::pow(0.5, level));
+    const Vector6d numeric =
+        numeric_gradient(cost, pose, shaded_.center_object, 0.005 * px_m / 0.07, 0.005 * px_m);
+    // As AnalyticGradientMatchesNumericOnEveryLevel: 2 % of the gradient's norm.
+    EXPECT_LT((analytic - numeric).norm(), 0.02 * numeric.norm())
+        << "level " << level << "\nanalytic " << analytic.transpose() << "\nnumeric "
+        << numeric.transpose();
+  }
+  // Shifted energies read the chromaticity too.
+  cost.linearize(pose, 1);
+  std::vector<int> counts;
+  const std::vector<Eigen::Vector3d> shifts{{0.002, -0.001, 0.0}};
+  Pose shifted = pose;
+  shifted.translation() += shifts[0];
+  EXPECT_NEAR(cost.shifted_energies(pose, shifts, &counts)[0], cost.energy(shifted), 1e-9 * cost.energy(shifted));
+}
+
 TEST(ContourCost, RejectsBadSettings) {
   auto mesh = std::make_shared<Mesh>(test::make_box(0.1, 0.1, 0.1, false));
   auto extractor = std::make_shared<ContourExtractor>(mesh, nullptr, 45.0);
@@ -266,6 +366,7 @@ TEST(ContourCost, RejectsBadSettings) {
   EXPECT_THROW(ContourCost(extractor, 0.0, 1.0), std::invalid_argument);
   EXPECT_THROW(ContourCost(extractor, 2.0, -1.0), std::invalid_argument);
   EXPECT_THROW(ContourCost(extractor, 2.0, 1.0, 0), std::invalid_argument);
+  EXPECT_THROW(ContourCost(extractor, 2.0, 1.0, 1, -0.5), std::invalid_argument);
 }
 
 }  // namespace

@@ -39,6 +39,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.keypoint_motion_gate_sigmas, 0.0);
   EXPECT_DOUBLE_EQ(p.motion_prior_weight, 0.0);
   EXPECT_DOUBLE_EQ(p.region_weight, 0.0);
+  EXPECT_DOUBLE_EQ(p.contour_chroma_weight, 0.0);
   EXPECT_DOUBLE_EQ(p.rotation_check_deg, 0.0);
   EXPECT_DOUBLE_EQ(p.texture_check_margin, 0.0);
   EXPECT_FALSE(p.texture_check_every_frame);
@@ -64,6 +65,7 @@ TEST(TrackerParams, CueFieldsAreValidated) {
   EXPECT_TRUE(rejects("keypoint_motion_gate_sigmas", "-2"));
   EXPECT_TRUE(rejects("motion_prior_weight", "-0.1"));
   EXPECT_TRUE(rejects("region_weight", "-1"));
+  EXPECT_TRUE(rejects("contour_chroma_weight", "-1"));
   EXPECT_TRUE(rejects("rotation_check_deg", "-5"));
   EXPECT_TRUE(rejects("rotation_check_frames", "0"));
   EXPECT_TRUE(rejects("rotation_check_margin", "-0.1"));
@@ -121,7 +123,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 103u);
+  EXPECT_EQ(fields.size(), 105u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

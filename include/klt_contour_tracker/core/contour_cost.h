@@ -44,8 +44,10 @@ class ContourCost : public PoseCost {
   /// each level before differentiating (widens the basin). `num_threads` (>= 1): threads for
   /// the per-frame image derivatives; the result does not depend on it. Throws
   /// std::invalid_argument for a null extractor or bad values.
+  /// `chroma_weight` > 0: where the frame's levels carry their chromaticity (PyramidLevel::
+  /// chroma), f_k = |grad I . n| + chroma_weight * sum over its two channels of |grad C . n|.
   ContourCost(std::shared_ptr<const ContourExtractor> extractor, double spacing_px,
-              double blur_sigma_px, int num_threads = 1);
+              double blur_sigma_px, int num_threads = 1, double chroma_weight = 0.0);
 
   std::string name() const override { return "contour"; }
   void begin_frame(const PoseCostFrame& frame) override;
@@ -70,10 +72,15 @@ class ContourCost : public PoseCost {
   double edge_width_px() const { return edge_width_px_; }
 
  private:
+  /// The level whose chromaticity derivatives `level` reads (-1: none).
+  int chroma_level(int level) const;
   /// Per level: image derivatives inside `roi` (level px), CV_32F, origin at roi.tl().
   struct LevelImages {
     cv::Rect roi;
     cv::Mat gx, gy;
+    /// The chromaticity channels' derivatives times chroma_weight (empty: grey only).
+    cv::Mat chroma_gx[2], chroma_gy[2];
+    double chroma_contrast = 0.0;  ///< the chromaticity's share of `contrast` (its own level)
     double contrast = 1.0;
   };
   struct Segment {
@@ -87,6 +94,7 @@ class ContourCost : public PoseCost {
   std::shared_ptr<const ContourExtractor> extractor_;
   double spacing_px_;
   double blur_sigma_px_;
+  double chroma_weight_;
   double edge_width_px_;
   Eigen::Vector3d center_object_;  ///< the mesh's bounding-box centre, object frame, m
   double radius_m_ = 0.0;          ///< the mesh's bounding-sphere radius about it, m

@@ -292,6 +292,15 @@ struct TrackerParams {
   std::string visibility_cache_dir;        ///< ours: "" = no disk cache
   double contour_sample_spacing_px = 2.0;  ///< ours: spacing of energy points on the contour
   double blur_sigma_px = 1.1;              ///< paper: Gaussian sigma before the main optimization
+  /// ours (coarse_to_fine): weight of the colour frame's chromaticity edges in the contour
+  /// energy, beside the grey edges (0 = grey only, the paper). Chromaticity (r - g, r + g - 2 b
+  /// over r + g + b) does not change with shading, so the dark rim of a curved object's outline
+  /// does not pull the contour inside the object.
+  double contour_chroma_weight = 0.0;
+  /// ours (needs texture_check_margin): contour_chroma_weight only for a track whose surface,
+  /// learned on the initial (colour) frame, has no colour pattern: there the outline is the
+  /// only colour edge; a printed pattern's colour edges compete with it.
+  bool contour_chroma_plain_only = false;
   int final_hops = 5;                      ///< paper: hops of the last run on the unblurred frame
   double hops_budget = 25000.0;            ///< paper: s = max{1, budget / (|V| + |F|)}
   int min_hops_cap = 100;                  ///< paper: min hops = min{10 s, cap}
