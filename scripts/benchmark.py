@@ -78,6 +78,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_tracked_surface_check", "realtime", {"tracked_search_surface_drop": "0"}),
     # an object without a colour pattern weighs its keypoints as much as a printed one
     ("realtime_no_plain_surface_scale", "realtime", {"plain_surface_keypoint_scale": "1"}),
+    # the contour energy of an object without a colour pattern reads grey edges only
+    ("realtime_no_chroma", "realtime", {"contour_chroma_weight": "0"}),
     # the refinement of a small object starts at the pyramid's coarsest level all the same
     ("realtime_no_pyramid_min_object", "realtime", {"pyramid_min_object_px": "0"}),
     # contour points next to anchors whose KLT track just failed (an occluder) are kept

@@ -911,10 +911,14 @@ TEST(TrackingSession, ATrackedSearchFindWithoutTheObjectsSurfaceIsNotTaken) {
 /// plain_surface_keypoint_scale: the surface learned on a uniformly coloured box's initial frame
 /// has no colour pattern, so that track's refinement weighs its keypoints less; a printed box's
 /// keeps the weight, and so does a track started on a grey frame (nothing learned). A new start
-/// is judged again.
+/// is judged again. contour_chroma_plain_only: the contour energy reads the chromaticity for
+/// the plain box's track only.
 TEST(TrackingSession, AnObjectWithoutAColourPatternWeighsItsKeypointsLess) {
   const TrackerParams params = quick_realtime();
   ASSERT_LT(params.plain_surface_keypoint_scale, 1.0) << "realtime scales them";
+  ASSERT_TRUE(params.contour_chroma_plain_only && params.contour_chroma_weight > 0.0)
+      << "realtime reads the chromaticity for plain objects";
+  const double chroma = params.contour_chroma_weight;
   const double weight = params.keypoint_weight;
   const double plain_weight = weight * params.plain_surface_keypoint_scale;
   ASSERT_LT(plain_weight, weight);
@@ -947,11 +951,14 @@ TEST(TrackingSession, AnObjectWithoutAColourPatternWeighsItsKeypointsLess) {
     EXPECT_EQ(session.plain_surface(), c.plain) << c.what;
     EXPECT_DOUBLE_EQ(session.tracker().params().keypoint_weight, c.plain ? plain_weight : weight) << c.what;
     EXPECT_DOUBLE_EQ(session.params().keypoint_weight, weight) << c.what << ": the session's own params keep it";
+    EXPECT_DOUBLE_EQ(session.tracker().params().contour_chroma_weight, c.plain ? chroma : 0.0) << c.what;
+    EXPECT_DOUBLE_EQ(session.params().contour_chroma_weight, chroma) << c.what;
     // Started again on a grey frame: nothing learned, the weight is the preset's again.
     session.initialize(start);
     session.track({frame_of(renderer, true), stamp});
     EXPECT_FALSE(session.plain_surface()) << c.what;
     EXPECT_DOUBLE_EQ(session.tracker().params().keypoint_weight, weight) << c.what;
+    EXPECT_DOUBLE_EQ(session.tracker().params().contour_chroma_weight, 0.0) << c.what;
   }
 }
 
