@@ -153,7 +153,8 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
   for (std::size_t l = 0; same && l < rois.size(); ++l)
     same = levels_source_[l].data == frame.levels[l].gray.data &&
            levels_source_[l].size() == frame.levels[l].gray.size() && levels_[l].roi == rois[l] &&
-           levels_[l].chroma_gx[0].empty() == (chroma_level(static_cast<int>(l)) != static_cast<int>(l));
+           levels_[l].chroma_gx[0].empty() ==
+               (chroma_level(static_cast<int>(l)) != static_cast<int>(l));
   if (same) return;
   levels_source_.clear();
   levels_.assign(frame.levels.size(), LevelImages());
@@ -166,8 +167,8 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
     if (roi.empty()) return;
     // Blur on a slightly larger window so that the region's border is not biased by padding.
     const int pad = static_cast<int>(std::ceil(3.0 * blur_sigma_px_)) + 2;
-    const cv::Rect outer = cv::Rect(roi.x - pad, roi.y - pad, roi.width + 2 * pad,
-                                    roi.height + 2 * pad) & bounds;
+    const cv::Rect outer =
+        cv::Rect(roi.x - pad, roi.y - pad, roi.width + 2 * pad, roi.height + 2 * pad) & bounds;
     const cv::Rect inner(roi.x - outer.x, roi.y - outer.y, roi.width, roi.height);
     // Blurred, then Sobel 3x3 / 8: a ramp of slope s gives s (as GradientImage::compute).
     const auto derivatives = [&](const cv::Mat& source, double scale, cv::Mat* dx, cv::Mat* dy) {
@@ -204,7 +205,8 @@ void ContourCost::begin_frame(const PoseCostFrame& frame) {
   for (std::size_t l = 0; l < levels_.size(); ++l) {
     const int at = chroma_level(static_cast<int>(l));
     if (at >= 0)
-      levels_[l].contrast += levels_[at].chroma_contrast * frame.levels[at].scale / frame.levels[l].scale;
+      levels_[l].contrast +=
+          levels_[at].chroma_contrast * frame.levels[at].scale / frame.levels[l].scale;
     levels_[l].contrast = std::max(1e-3, levels_[l].contrast);
   }
   for (const PyramidLevel& level : frame.levels) levels_source_.push_back(level.gray);
@@ -321,9 +323,9 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
       const Eigen::Vector3d x = r * samples_[k] + t;
       Cell c;
       if (!cell_of(x, project, images.roi, &c) || hidden(images.roi, c)) continue;
-      // Each channel's |g . n|: the grey one at (x0, y0) and, when used, the two chromaticity
-      // ones read on their own level (`scale` its px per this level's px: a gradient there is
-      // scale x one here, and its derivative scale^2 x).
+      // Each channel's |g . n|: the grey one at the point's cell and, when used, the two
+      // chromaticity ones read on their own level (`scale` its px per this level's px: a
+      // gradient there is scale x one here, and its derivative scale^2 x).
       const cv::Mat* channel_gx[3] = {&images.gx, nullptr, nullptr};
       const cv::Mat* channel_gy[3] = {&images.gy, nullptr, nullptr};
       Cell cells[3] = {c, c, c};
@@ -342,20 +344,24 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
         }
       }
       double value = 0.0;
-      const Matrix26d jp = derivatives ? projection_jacobian(x, center_camera, fx, fy) : Matrix26d();
+      const Matrix26d jp =
+          derivatives ? projection_jacobian(x, center_camera, fx, fy) : Matrix26d();
       for (int ch = 0; ch < channels; ++ch) {
         const cv::Mat& cgx = *channel_gx[ch];
         const cv::Mat& cgy = *channel_gy[ch];
         const Cell& cell = cells[ch];
-        const Eigen::Vector2d g = scale[ch] * Eigen::Vector2d(bilinear(cgx, cell.x0, cell.y0, cell.ax, cell.ay),
-                                                              bilinear(cgy, cell.x0, cell.y0, cell.ax, cell.ay));
+        const Eigen::Vector2d g =
+            scale[ch] * Eigen::Vector2d(bilinear(cgx, cell.x0, cell.y0, cell.ax, cell.ay),
+                                        bilinear(cgy, cell.x0, cell.y0, cell.ax, cell.ay));
         const double along = g.dot(normal);
         value += std::abs(along);
         if (!gradient) continue;
         // d(g . n)/dp = n^T dg/dp, dg/dp the exact derivative of the bilinear interpolation.
         const double s2 = scale[ch] * scale[ch];
-        const Eigen::Vector2d dgx = s2 * bilinear_derivative(cgx, cell.x0, cell.y0, cell.ax, cell.ay);
-        const Eigen::Vector2d dgy = s2 * bilinear_derivative(cgy, cell.x0, cell.y0, cell.ax, cell.ay);
+        const Eigen::Vector2d dgx =
+            s2 * bilinear_derivative(cgx, cell.x0, cell.y0, cell.ax, cell.ay);
+        const Eigen::Vector2d dgy =
+            s2 * bilinear_derivative(cgy, cell.x0, cell.y0, cell.ax, cell.ay);
         const Eigen::RowVector2d dvalue_dp(normal.x() * dgx.x() + normal.y() * dgy.x(),
                                            normal.x() * dgx.y() + normal.y() * dgy.y());
         const double sign = along >= 0.0 ? 1.0 : -1.0;
@@ -440,9 +446,10 @@ std::vector<double> ContourCost::shifted_energies(const Pose& object_to_camera,
         if (chroma && cell_at((q.u + du * q.inv_z) * to_chroma, (q.v + dv * q.inv_z) * to_chroma,
                               chroma->roi, &cc))
           for (int k = 0; k < 2; ++k)
-            sum += to_chroma *
-                   std::abs(bilinear(chroma->chroma_gx[k], cc.x0, cc.y0, cc.ax, cc.ay) * normal.x() +
-                            bilinear(chroma->chroma_gy[k], cc.x0, cc.y0, cc.ax, cc.ay) * normal.y());
+            sum +=
+                to_chroma *
+                std::abs(bilinear(chroma->chroma_gx[k], cc.x0, cc.y0, cc.ax, cc.ay) * normal.x() +
+                         bilinear(chroma->chroma_gy[k], cc.x0, cc.y0, cc.ax, cc.ay) * normal.y());
         ++kept;
       }
     }

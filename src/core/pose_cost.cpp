@@ -58,14 +58,15 @@ cv::Mat chromaticity(const cv::Mat& bgr) {
     for (int u = 0; u < bgr.cols; ++u) {
       const float b = in[u][0], g = in[u][1], r = in[u][2];
       const float inverse_intensity = 1.0f / (r + g + b + kDarkOffset);
-      out[u] = cv::Vec2f(k1 * (r - g) * inverse_intensity, k2 * (r + g - 2.0f * b) * inverse_intensity);
+      out[u] =
+          cv::Vec2f(k1 * (r - g) * inverse_intensity, k2 * (r + g - 2.0f * b) * inverse_intensity);
     }
   }
   return chroma;
 }
 
-std::vector<PyramidLevel> make_pyramid(const cv::Mat& gray, const PinholeCamera& camera,
-                                       int levels, const cv::Mat& bgr) {
+std::vector<PyramidLevel> make_pyramid(const cv::Mat& gray, const PinholeCamera& camera, int levels,
+                                       const cv::Mat& bgr) {
   if (gray.empty() || gray.type() != CV_8UC1)
     throw std::invalid_argument("make_pyramid: gray must be a non-empty CV_8UC1 image");
   if (levels < 1) throw std::invalid_argument("make_pyramid: levels must be >= 1");

@@ -262,7 +262,8 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
   const bool refine = params_.refine && refiner_;
   const cv::Mat gray = refine ? to_gray(frame.image) : cv::Mat();
   // The colour frame, when the contour energy uses its chromaticity (empty for grey frames).
-  const cv::Mat bgr = refine && params_.contour_chroma_weight > 0.0 ? to_bgr(frame.image) : cv::Mat();
+  const cv::Mat bgr =
+      refine && params_.contour_chroma_weight > 0.0 ? to_bgr(frame.image) : cv::Mat();
   TrackerParams widened = params_;
   widened.extrapolated_rotation_bound_deg =
       std::min(180.0, params_.extrapolated_rotation_bound_deg * search_scale);

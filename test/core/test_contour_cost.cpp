@@ -293,9 +293,9 @@ class ShadedRimTest : public ContourCostTest {
       for (int u = 0; u < bgr.cols; ++u)
         if (mask.at<uchar>(v, u)) {
           const double shade = 0.4 + 0.6 * std::min(1.0, (inside.at<float>(v, u) - 1.0) / 6.0);
-          bgr.at<cv::Vec3b>(v, u) = cv::Vec3b(cv::saturate_cast<uchar>(20 * shade),
-                                              cv::saturate_cast<uchar>(110 * shade),
-                                              cv::saturate_cast<uchar>(220 * shade));
+          bgr.at<cv::Vec3b>(v, u) =
+              cv::Vec3b(cv::saturate_cast<uchar>(20 * shade), cv::saturate_cast<uchar>(110 * shade),
+                        cv::saturate_cast<uchar>(220 * shade));
         }
     cv::Mat gray;
     cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
@@ -356,7 +356,8 @@ TEST_F(ShadedRimTest, AnalyticGradientWithChromaticityMatchesNumericOnEveryLevel
   const std::vector<Eigen::Vector3d> shifts{{0.002, -0.001, 0.0}};
   Pose shifted = pose;
   shifted.translation() += shifts[0];
-  EXPECT_NEAR(cost.shifted_energies(pose, shifts, &counts)[0], cost.energy(shifted), 1e-9 * cost.energy(shifted));
+  EXPECT_NEAR(cost.shifted_energies(pose, shifts, &counts)[0], cost.energy(shifted),
+              1e-9 * cost.energy(shifted));
 }
 
 TEST(ContourCost, RejectsBadSettings) {

@@ -951,7 +951,8 @@ TEST(TrackingSession, AnObjectWithoutAColourPatternWeighsItsKeypointsLess) {
     EXPECT_EQ(session.plain_surface(), c.plain) << c.what;
     EXPECT_DOUBLE_EQ(session.tracker().params().keypoint_weight, c.plain ? plain_weight : weight) << c.what;
     EXPECT_DOUBLE_EQ(session.params().keypoint_weight, weight) << c.what << ": the session's own params keep it";
-    EXPECT_DOUBLE_EQ(session.tracker().params().contour_chroma_weight, c.plain ? chroma : 0.0) << c.what;
+    EXPECT_DOUBLE_EQ(session.tracker().params().contour_chroma_weight, c.plain ? chroma : 0.0)
+        << c.what;
     EXPECT_DOUBLE_EQ(session.params().contour_chroma_weight, chroma) << c.what;
     // Started again on a grey frame: nothing learned, the weight is the preset's again.
     session.initialize(start);

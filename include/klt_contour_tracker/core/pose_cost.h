@@ -52,7 +52,7 @@ Matrix26d projection_jacobian(const Eigen::Vector3d& point_camera,
 /// One level of the image pyramid shared by the cues: level l has the frame's size / 2^l.
 struct PyramidLevel {
   cv::Mat gray;          ///< CV_8UC1, undistorted
-  cv::Mat bgr;           ///< CV_8UC3, the same level in colour (make_pyramid with a colour frame), or empty
+  cv::Mat bgr;           ///< CV_8UC3, this level in colour (given a colour frame), or empty
   PinholeCamera camera;  ///< intrinsics of this level (pixel centres at integer coordinates)
   double scale = 1.0;    ///< this level's pixels per full-resolution pixel (1 / 2^l)
 };
@@ -79,8 +79,8 @@ struct PoseCostFrame {
 /// Builds `levels` levels (>= 1) of a PoseCostFrame pyramid from a CV_8UC1 frame and its
 /// full-resolution camera (cv::pyrDown; level cameras follow its pixel-centre convention).
 /// With `bgr` (CV_8UC3, the same frame in colour) each level also gets its colour image.
-std::vector<PyramidLevel> make_pyramid(const cv::Mat& gray, const PinholeCamera& camera,
-                                       int levels, const cv::Mat& bgr = cv::Mat());
+std::vector<PyramidLevel> make_pyramid(const cv::Mat& gray, const PinholeCamera& camera, int levels,
+                                       const cv::Mat& bgr = cv::Mat());
 
 /// The shading-invariant colour of a CV_8UC3 BGR frame, CV_32FC2: the opponent differences
 /// (r - g) / sqrt 2 and (r + g - 2 b) / sqrt 6 divided by the intensity r + g + b (+ 30, so
