@@ -323,41 +323,22 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
       const Eigen::Vector3d x = r * samples_[k] + t;
       Cell c;
       if (!cell_of(x, project, images.roi, &c) || hidden(images.roi, c)) continue;
-      // Each channel's |g . n|: the grey one at the point's cell and, when used, the two
-      // chromaticity ones read on their own level (`scale` its px per this level's px: a
-      // gradient there is scale x one here, and its derivative scale^2 x).
-      const cv::Mat* channel_gx[3] = {&images.gx, nullptr, nullptr};
-      const cv::Mat* channel_gy[3] = {&images.gy, nullptr, nullptr};
-      Cell cells[3] = {c, c, c};
-      double scale[3] = {1.0, 1.0, 1.0};
-      int channels = 1;
-      if (chroma) {
-        const Eigen::Vector2d p = project(x);
-        if (cell_at(p.x() * to_chroma, p.y() * to_chroma, chroma->roi, &cells[1])) {
-          for (int k = 0; k < 2; ++k) {
-            channel_gx[1 + k] = &chroma->chroma_gx[k];
-            channel_gy[1 + k] = &chroma->chroma_gy[k];
-            cells[1 + k] = cells[1];
-            scale[1 + k] = to_chroma;
-          }
-          channels = 3;
-        }
-      }
+      // Each channel's |g . n| (and its derivative) at `cell` of its images: the grey one here
+      // and, when used, the two chromaticity ones read on their own level (`scale` its px per
+      // this level's px: a gradient there is scale x one here, its derivative scale^2 x).
       double value = 0.0;
       const Matrix26d jp =
           derivatives ? projection_jacobian(x, center_camera, fx, fy) : Matrix26d();
-      for (int ch = 0; ch < channels; ++ch) {
-        const cv::Mat& cgx = *channel_gx[ch];
-        const cv::Mat& cgy = *channel_gy[ch];
-        const Cell& cell = cells[ch];
+      const auto add_channel = [&](const cv::Mat& cgx, const cv::Mat& cgy, const Cell& cell,
+                                   double scale) {
         const Eigen::Vector2d g =
-            scale[ch] * Eigen::Vector2d(bilinear(cgx, cell.x0, cell.y0, cell.ax, cell.ay),
-                                        bilinear(cgy, cell.x0, cell.y0, cell.ax, cell.ay));
+            scale * Eigen::Vector2d(bilinear(cgx, cell.x0, cell.y0, cell.ax, cell.ay),
+                                    bilinear(cgy, cell.x0, cell.y0, cell.ax, cell.ay));
         const double along = g.dot(normal);
         value += std::abs(along);
-        if (!gradient) continue;
+        if (!gradient) return;
         // d(g . n)/dp = n^T dg/dp, dg/dp the exact derivative of the bilinear interpolation.
-        const double s2 = scale[ch] * scale[ch];
+        const double s2 = scale * scale;
         const Eigen::Vector2d dgx =
             s2 * bilinear_derivative(cgx, cell.x0, cell.y0, cell.ax, cell.ay);
         const Eigen::Vector2d dgy =
@@ -366,6 +347,14 @@ double ContourCost::accumulate(const Pose& object_to_camera, int* count, Vector6
                                            normal.x() * dgx.y() + normal.y() * dgy.y());
         const double sign = along >= 0.0 ? 1.0 : -1.0;
         *gradient += sign * (dvalue_dp * jp + g.transpose() * normal_jacobian).transpose();
+      };
+      add_channel(images.gx, images.gy, c, 1.0);
+      Cell chroma_cell;
+      if (chroma) {
+        const Eigen::Vector2d p = project(x);
+        if (cell_at(p.x() * to_chroma, p.y() * to_chroma, chroma->roi, &chroma_cell))
+          for (int k = 0; k < 2; ++k)
+            add_channel(chroma->chroma_gx[k], chroma->chroma_gy[k], chroma_cell, to_chroma);
       }
       sum += value;
       ++kept;

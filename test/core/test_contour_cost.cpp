@@ -93,6 +93,22 @@ TEST(PoseCostSum, WeightsEachCueAndSkipsZeroWeights) {
   EXPECT_DOUBLE_EQ(h(3, 3), 4.0);
 }
 
+/// The cost's analytic gradient at `pose` (0.45 m away) on the linearized `level` against
+/// central differences with steps moving the contour by about 0.005 level px (few points cross
+/// a pixel cell's border, where the bilinear interpolation's derivative jumps): within 2 % of the
+/// gradient's norm (those crossings).
+void expect_gradient_matches_numeric(const PoseCost& cost, const Pose& pose,
+                                     const Eigen::Vector3d& center, const PinholeCamera& camera,
+                                     int level, Matrix6d* hessian = nullptr) {
+  Vector6d analytic = Vector6d::Zero();
+  cost.evaluate(pose, &analytic, hessian);
+  const double px_m = 0.45 / (camera.fx() * std::pow(0.5, level));
+  const Vector6d numeric = numeric_gradient(cost, pose, center, 0.005 * px_m / 0.07, 0.005 * px_m);
+  EXPECT_LT((analytic - numeric).norm(), 0.02 * numeric.norm())
+      << "level " << level << "\nanalytic " << analytic.transpose() << "\nnumeric "
+      << numeric.transpose();
+}
+
 class ContourCostTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -123,18 +139,8 @@ TEST_F(ContourCostTest, AnalyticGradientMatchesNumericOnEveryLevel) {
   for (int level = 0; level < 3; ++level) {
     cost.linearize(pose, level);
     ASSERT_TRUE(cost.active());
-    Vector6d analytic = Vector6d::Zero();
     Matrix6d hessian = Matrix6d::Zero();
-    cost.evaluate(pose, &analytic, &hessian);
-    // Steps moving the contour by about 0.005 level px: few points cross a pixel cell's border
-    // (where the bilinear interpolation's derivative jumps).
-    const double px_m = 0.45 / (camera_.fx() * std::pow(0.5, level));
-    const Vector6d numeric =
-        numeric_gradient(cost, pose, frame_.center_object, 0.005 * px_m / 0.07, 0.005 * px_m);
-    // Tolerance: 2% of the gradient's norm (the cell-border crossings).
-    EXPECT_LT((analytic - numeric).norm(), 0.02 * numeric.norm())
-        << "level " << level << "\nanalytic " << analytic.transpose() << "\nnumeric "
-        << numeric.transpose();
+    expect_gradient_matches_numeric(cost, pose, frame_.center_object, camera_, level, &hessian);
     // The Hessian approximation is symmetric positive semi-definite.
     EXPECT_LT((hessian - hessian.transpose()).norm(), 1e-12 * hessian.norm());
     EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix6d>(hessian).eigenvalues().minCoeff(),
@@ -340,15 +346,7 @@ TEST_F(ShadedRimTest, AnalyticGradientWithChromaticityMatchesNumericOnEveryLevel
   for (int level = 0; level < 3; ++level) {
     cost.linearize(pose, level);
     ASSERT_TRUE(cost.active());
-    Vector6d analytic = Vector6d::Zero();
-    cost.evaluate(pose, &analytic, nullptr);
-    const double px_m = 0.45 / (camera_.fx() * std::pow(0.5, level));
-    const Vector6d numeric =
-        numeric_gradient(cost, pose, shaded_.center_object, 0.005 * px_m / 0.07, 0.005 * px_m);
-    // As AnalyticGradientMatchesNumericOnEveryLevel: 2 % of the gradient's norm.
-    EXPECT_LT((analytic - numeric).norm(), 0.02 * numeric.norm())
-        << "level " << level << "\nanalytic " << analytic.transpose() << "\nnumeric "
-        << numeric.transpose();
+    expect_gradient_matches_numeric(cost, pose, shaded_.center_object, camera_, level);
   }
   // Shifted energies read the chromaticity too.
   cost.linearize(pose, 1);

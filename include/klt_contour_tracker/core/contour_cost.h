@@ -44,8 +44,9 @@ class ContourCost : public PoseCost {
   /// each level before differentiating (widens the basin). `num_threads` (>= 1): threads for
   /// the per-frame image derivatives; the result does not depend on it. Throws
   /// std::invalid_argument for a null extractor or bad values.
-  /// `chroma_weight` > 0: where the frame's levels carry their chromaticity (PyramidLevel::
-  /// chroma), f_k = |grad I . n| + chroma_weight * sum over its two channels of |grad C . n|.
+  /// `chroma_weight` > 0: where the frame's levels carry their colour image (PyramidLevel::bgr),
+  /// f_k = |grad I . n| + chroma_weight * sum over the two chromaticity() channels of
+  /// |grad C . n|.
   ContourCost(std::shared_ptr<const ContourExtractor> extractor, double spacing_px,
               double blur_sigma_px, int num_threads = 1, double chroma_weight = 0.0);
 
