@@ -99,6 +99,9 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_repeat_recover", "realtime", {"repeat_recover_diameters": "0"}),
     # ORB keyframes matched while lost (feature_relocalizer.h) off: the colour search alone
     ("realtime_no_feature_relocalization", "realtime", {"feature_relocalization": "false"}),
+    # a tracked frame whose surface does not correlate with the learned one is not matched
+    # against the keyframes' features
+    ("realtime_no_surface_relocalization", "realtime", {"relocalization_below_correlation": "0"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     # the PnP pose made the most likely pose under a prior on the frame-to-frame motion

@@ -413,7 +413,8 @@ void TrackingSession::adopt_relocalized(const Frame& frame, const Pose& object_t
   result.relocalized = true;
 }
 
-void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
+void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result,
+                                   bool in_doubt) {
   const TrackStatus status = result.frame.status;
   if (relocalizer_->keyframes() == 0 ||
       (status != TrackStatus::kKeypoints && status != TrackStatus::kExtrapolated &&
@@ -433,8 +434,20 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
   // something else. A confident track is kept: repeated texture (Castle-simu's bricks) gives
   // 25 consistent but wrong matches.
   if (found.inliers < params_.relocalization_override_inliers) return;
-  if (status == TrackStatus::kKeypoints && monitor_.last_good()) return;
+  if (status == TrackStatus::kKeypoints && monitor_.last_good() && !in_doubt) return;
   adopt_relocalized(frame, found.object_to_camera, result);
+}
+
+bool TrackingSession::surface_disagrees(const SessionResult& result) const {
+  // Only a colour pattern's correlation says where the surface is (a plain object's "pattern"
+  // is its shading). A frame a check or search corrected has its own, better-founded pose.
+  const TrackStatus status = result.frame.status;
+  return params_.relocalization_below_correlation > 0.0 && relocalizer_ && texture_ &&
+         texture_->has_color_pattern() && !result.reacquiring && !result.rotation_corrected &&
+         !result.texture_corrected && !result.searched &&
+         (status == TrackStatus::kKeypoints || status == TrackStatus::kExtrapolated) &&
+         std::isfinite(result.texture_correlation) &&
+         result.texture_correlation < params_.relocalization_below_correlation;
 }
 
 bool TrackingSession::checkable(const TrackResult& held, const cv::Mat& bgr) const {
@@ -754,6 +767,10 @@ SessionResult TrackingSession::track(const Frame& frame) {
     if (result.frame.status == TrackStatus::kKeypoints && !result.rotation_corrected &&
         !result.texture_corrected)
       search_if_faded(frame, bgr, result, params_.tracked_search_ratio, true);
+    if (surface_disagrees(result)) {
+      if (gray.empty()) gray = features_frame();
+      if (!gray.empty()) use_features(frame, gray, result, true);
+    }
   }
   use_colors(bgr, result);
   if (texture_ && !bgr.empty() && result.frame.status == TrackStatus::kInitialized) {

@@ -123,7 +123,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 105u);
+  EXPECT_EQ(fields.size(), 106u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -166,6 +166,12 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   EXPECT_FALSE(realtime.relocalization_while_tracking);
   EXPECT_FALSE(make_preset("paper").feature_relocalization);
   EXPECT_FALSE(make_preset("klt_only").feature_relocalization);
+  // ... and on a tracked frame whose surface does not correlate (a doubt), paper never.
+  EXPECT_GT(realtime.relocalization_below_correlation, 0.0);
+  EXPECT_EQ(make_preset("paper").relocalization_below_correlation, 0.0);
+  bad = realtime;
+  bad.relocalization_below_correlation = 1.5;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
   // The session's colour model and the PnP motion bounds are ours: off in paper and klt_only.
   EXPECT_TRUE(realtime.color_search);
   EXPECT_FALSE(make_preset("paper").color_search);

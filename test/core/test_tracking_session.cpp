@@ -570,6 +570,8 @@ TEST(TrackingSession, ATrackHeldOnTheBackgroundIsSearchedForBeforeTheLoss) {
   params.extrapolated_search_ratio = 0.0;
   params.drop_unconfirmed_anchors = false;
   params.color_search_reach_diameters = 0.0;  // a jump beyond the reach, as in the test above
+  // The held pose's surface disagrees: the keyframe's features would find the box (another rule).
+  params.relocalization_below_correlation = 0.0;
   for (const double ratio : {0.0, params.tracked_search_ratio}) {
     params.tracked_search_ratio = ratio;
     TrackingSession session(scene.mesh, params);
@@ -806,6 +808,64 @@ TEST(TrackingSession, TextureCheckFindsATurnAboutTheObjectsAxis) {
     }
 }
 
+/// relocalization_below_correlation: the textured box vanishes for a frame (KLT fails) and comes
+/// back turned 180 deg about its own axis nearest the line of sight: the same outline (the box is
+/// symmetric), other faces' patterns. With the checks that could find the turn off (the texture
+/// check's turns need a margin no correlation reaches; no alignment, shift or rotation check),
+/// the track holds the unturned pose, whose surface does not correlate. In doubt by that alone,
+/// the keyframe's features are matched on the first frame back and their pose (the turn)
+/// replaces the held one: never lost. With the rule off the track is held about 175 deg off
+/// until it is declared lost (the features then re-acquire it).
+TEST(TrackingSession, ATrackWhoseSurfaceDisagreesIsRelocalizedByFeatures) {
+  const Scene scene;
+  const Pose start = test::make_pose(0.45);
+  ASSERT_GT(make_preset("realtime").relocalization_below_correlation, 0.0) << "realtime doubts such tracks";
+  const Eigen::Vector3d view = start.translation().normalized();  // the box is centred at its origin
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(start.linear().col(k).dot(view)) > std::abs(start.linear().col(axis).dot(view))) axis = k;
+  Pose truth = start;
+  truth.linear() = start.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
+  for (const bool doubt : {false, true}) {
+    SCOPED_TRACE(doubt ? "with the rule" : "without the rule");
+    TrackerParams params = quick_realtime();
+    params.texture_check_margin = 2.0;
+    params.texture_align_below = 0.0;
+    params.texture_shift_search_below = 0.0;
+    params.rotation_check_deg = 0.0;
+    params.relocalization_below_correlation = doubt ? make_preset("realtime").relocalization_below_correlation : 0.0;
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.initialize(start);
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033)
+      session.track({test::render_frame(scene.renderer, scene.camera, start, scene.background, 1.5, i), stamp});
+    session.track({scene.background.clone(), stamp});
+    stamp += 0.033;
+    std::vector<SessionResult> back;
+    for (int i = 0; i < 8; ++i, stamp += 0.033)
+      back.push_back(session.track(
+          {test::render_frame(scene.renderer, scene.camera, truth, scene.background, 1.5, 20 + i), stamp}));
+    const bool lost = std::any_of(back.begin(), back.end(),
+                                  [](const SessionResult& r) { return r.state == TrackState::kLost; });
+    // Tolerances: 5 mm and 2 deg for a 12 cm box at 0.45 m, as the relocalization test's.
+    const Pose& first = back.front().frame.object_to_camera;
+    if (doubt) {
+      EXPECT_TRUE(back.front().relocalized) << "not relocalized on the first frame back";
+      EXPECT_LT(rotation_error_deg(first, truth), 2.0);
+      EXPECT_LT(translation_error(first, truth), 0.005);
+      EXPECT_FALSE(lost);
+    } else {
+      EXPECT_FALSE(back.front().relocalized);
+      EXPECT_GT(rotation_error_deg(first, truth), 90.0)
+          << "the turned box was found without the rule: the test shows nothing";
+      EXPECT_TRUE(lost) << "the wrong hold was never declared lost";
+    }
+    EXPECT_LT(rotation_error_deg(back.back().frame.object_to_camera, truth), 2.0);
+    EXPECT_LT(translation_error(back.back().frame.object_to_camera, truth), 0.005);
+  }
+}
+
 /// texture_align_below: a textured cube vanishes for a frame (KLT fails) and comes back at the
 /// same place turned 15 deg about an axis that is none of its own (camera x and y mixed). The
 /// check's turns about the cube's axes and rotation_check's turns about the camera's (off here)
@@ -820,6 +880,7 @@ TEST(TrackingSession, TextureAlignmentFindsATurnAboutAnyAxis) {
   for (const bool align : {false, true}) {
     TrackerParams params = quick_realtime();
     params.rotation_check_deg = 0.0;
+    params.relocalization_below_correlation = 0.0;  // the features find the turn too
     params.texture_align_below = align ? 0.3 : 0.0;
     TrackingSession session(scene.cube, params);
     const CheckRun run = hide_and_show(session, scene.renderer, scene.camera, scene.background,

@@ -185,6 +185,17 @@ struct TrackerParams {
   /// frame around the held pose (the matching above, and keyframes from new viewpoints): 26.2
   /// against 12.3 ms median a frame on hard/chest/handheld.
   bool relocalization_while_tracking = true;
+  /// ours (tracking session; 0 = off; needs feature_relocalization and texture checks): a
+  /// tracked frame of an object with a colour pattern whose held pose's surface correlates below
+  /// this with the colours learned at the initial pose (texture_check_margin's measure,
+  /// [-1, 1]) is in doubt: the keyframes' features are matched around it (as with
+  /// relocalization_while_tracking, on this frame only) and a pose from at least
+  /// relocalization_override_inliers of them that disagrees replaces it. After a blurred jerk a
+  /// search can settle on part of the object (the blue front of a chest, seen from 40 deg off
+  /// and 15 cm deeper) that every other cue accepts, and KLT follows it; its surface does not
+  /// correlate (measured on both hard sets: tracked frames of the can and chest correlating below
+  /// 0 were 0.1 diameters off or more on 329 of 350).
+  double relocalization_below_correlation = 0.0;
   /// ours (tracking session, 0 = off; needs color_search): for rotation_check_frames frames
   /// after KLT failed or the track was re-acquired, the tracked pose is also turned by
   /// +-rotation_check_deg about each camera axis through the object's centre and each turn is

@@ -195,8 +195,13 @@ class TrackingSession {
                               SessionResult& result);
   void count(const SessionResult& result);
   /// feature_relocalization, on a frame the pipeline tracked (`gray` undistorted): the
-  /// keyframes' features around the held pose confirm it, or replace it when they disagree.
-  void use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result);
+  /// keyframes' features around the held pose confirm it, or replace it when they disagree
+  /// and the track is in doubt (KLT failed, the last frame was bad, or `in_doubt`).
+  void use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result,
+                    bool in_doubt = false);
+  /// relocalization_below_correlation: the tracked frame `result`'s surface (a colour
+  /// pattern's) does not correlate with the learned one.
+  bool surface_disagrees(const SessionResult& result) const;
   /// feature_relocalization, while lost: the keyframes' features over the whole frame; true
   /// when they re-acquired the object (`result` then holds it).
   bool relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result);
