@@ -223,6 +223,12 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
           unconfirmed_ = found.front().object_to_camera;
         return TrackResult();
       }
+      // The same slack per placement: a placement far below the bar is not refined, nor are its
+      // turns (found is best first, so the kept ones are a prefix).
+      const auto far_below = [&](const SearchCandidate& c) {
+        return c.contrast < bar.min_contrast - kTrackedSearchRefineSlack * level;
+      };
+      found.erase(std::find_if(found.begin(), found.end(), far_below), found.end());
     }
     std::vector<Pose> hypotheses{last_good};
     const Eigen::Vector3d& center_object = tracker_->center_object();
