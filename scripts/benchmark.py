@@ -1083,21 +1083,29 @@ FAR_CONDITIONS = {
 }
 
 
-def far_sequence(data, obj, cond, frames):
-    seed = sequence_seed("far", obj, cond)
-    backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
-    return generated_sequence(data, obj, os.path.join(data, "far", obj, cond), frames, seed,
-                              backgrounds[seed % len(backgrounds)], HARD_BASE, FAR_CONDITIONS[cond][1],
-                              "rendering far/%s/%s" % (obj, cond))
+def run_hard_variant(args, configs, runner, data, docs_dir, tmp, set_name, conditions, frames,
+                     quick_condition):
+    """A section of the hard rendering with its own conditions (name: (title, generate_sequence
+    options on top of HARD_BASE)), frames and seeds (tagged set_name), rendered into
+    data/<set_name>/<object>/<condition> (cached) and tracked as the hard sections are."""
+    objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
+    chosen = [quick_condition] if args.quick else list(conditions)
+    frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or frames)
+
+    def sequence(obj, cond):
+        seed = sequence_seed(set_name, obj, cond)
+        backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
+        return generated_sequence(data, obj, os.path.join(data, set_name, obj, cond), frames, seed,
+                                  backgrounds[seed % len(backgrounds)], HARD_BASE, conditions[cond][1],
+                                  "rendering %s/%s/%s" % (set_name, obj, cond))
+    folders = {(o, c): sequence(o, c) for o in objects for c in chosen}
+    return run_hard(args, configs, runner, data, docs_dir, tmp, set_name=set_name, folders=folders,
+                    condition_titles=conditions, folder_frames=frames)
 
 
 def run_far(args, configs, runner, data, docs_dir, tmp):
-    objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
-    conditions = ["handheld"] if args.quick else list(FAR_CONDITIONS)
-    frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or HARD_FRAMES)
-    folders = {(o, c): far_sequence(data, o, c, frames) for o in objects for c in conditions}
-    return run_hard(args, configs, runner, data, docs_dir, tmp, set_name="far", folders=folders,
-                    condition_titles=FAR_CONDITIONS, folder_frames=frames)
+    return run_hard_variant(args, configs, runner, data, docs_dir, tmp, "far", FAR_CONDITIONS, HARD_FRAMES,
+                            "handheld")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1115,21 +1123,9 @@ LONG_CONDITIONS = {
 }
 
 
-def long_sequence(data, obj, cond, frames):
-    seed = sequence_seed("long", obj, cond)
-    backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
-    return generated_sequence(data, obj, os.path.join(data, "long", obj, cond), frames, seed,
-                              backgrounds[seed % len(backgrounds)], HARD_BASE, LONG_CONDITIONS[cond][1],
-                              "rendering long/%s/%s" % (obj, cond))
-
-
 def run_long(args, configs, runner, data, docs_dir, tmp):
-    objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
-    conditions = ["clutter"] if args.quick else list(LONG_CONDITIONS)
-    frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or LONG_FRAMES)
-    folders = {(o, c): long_sequence(data, o, c, frames) for o in objects for c in conditions}
-    return run_hard(args, configs, runner, data, docs_dir, tmp, set_name="long", folders=folders,
-                    condition_titles=LONG_CONDITIONS, folder_frames=frames)
+    return run_hard_variant(args, configs, runner, data, docs_dir, tmp, "long", LONG_CONDITIONS, LONG_FRAMES,
+                            "clutter")
 
 
 def run_photo(args, configs, runner, data, docs_dir, tmp):
