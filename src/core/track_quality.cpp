@@ -115,6 +115,16 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
       last_quality_ = std::min(last_quality_, params_.min_quality * 0.5);
     }
   }
+  // A run of extrapolated frames (ours): the pose comes from the contour alone. Over 11 long
+  // sequences (300-600 frames), 1 of 313 good frames of such runs was within 0.1 diameters of
+  // the truth, none after the fourth frame of a run: held on the background's edges, the energy
+  // level and the colour model follow the wrong pose.
+  extrapolated_frames_ = result.status == TrackStatus::kExtrapolated ? extrapolated_frames_ + 1 : 0;
+  if (rule.extrapolated_good_frames >= 0 && extrapolated_frames_ > rule.extrapolated_good_frames &&
+      last_good_) {
+    last_good_ = false;
+    last_quality_ = std::min(last_quality_, params_.min_quality * 0.5);
+  }
   // A held frame (rule.surface_hold_correlation): the surface says the pose is right while the
   // energy and the keypoints say it is not; the counters and the levels stay as they are.
   const bool tracked = result.status == TrackStatus::kKeypoints ||
@@ -160,6 +170,7 @@ void TrackQualityMonitor::on_initialized(const Pose& object_to_camera) {
   color_level_ = 0.0;
   has_color_level_ = false;
   bad_frames_ = good_frames_ = 0;
+  extrapolated_frames_ = 0;
   last_held_ = false;
 }
 

@@ -792,6 +792,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   rule.recover_ratio = params_.color_recover_ratio;
   rule.recover_min_visible = params_.color_recover_min_visible;
   rule.surface_hold_correlation = params_.surface_hold_correlation;
+  rule.extrapolated_good_frames = params_.extrapolated_good_frames;
   // Only a colour pattern's correlation says where the surface is (a grey object's "pattern" is
   // its shading, which a wrong pose of the castle matched at >= 0.7: hard2/castle/leave -5.5).
   if (texture_ && texture_->has_color_pattern())

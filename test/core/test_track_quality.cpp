@@ -322,6 +322,52 @@ TEST(TrackQuality, ASurfaceThatStillMatchesHoldsABadTrackedFrame) {
   EXPECT_EQ(off.update(blurred, matching, none), TrackState::kLost);
 }
 
+/// extrapolated_good_frames: the first N frames in a row that KLT failed on can be good, later
+/// ones are bad until KLT tracks again; -1 (off) leaves them to their score.
+TEST(TrackQuality, OnlyTheFirstExtrapolatedFramesInARowCanBeGood) {
+  TrackQualityParams params;
+  params.lost_after_bad_frames = 3;
+  params.energy_level_smoothing = 1.0;
+  const TrackResult tracked = refined_result(10.0, true, 1.0);
+  const TrackResult extrapolated = refined_result(10.0, false, 0.0);  // 0.7: good by its score
+  ColorLossRule rule;
+  rule.extrapolated_good_frames = 2;
+
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  monitor.update(tracked, {}, rule);
+  for (int round = 0; round < 2; ++round) {  // KLT tracking again starts the count over
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_EQ(monitor.update(extrapolated, {}, rule), TrackState::kTracking);
+      EXPECT_TRUE(monitor.last_good());
+      EXPECT_NEAR(monitor.last_quality(), 0.7, 1e-12);
+    }
+    EXPECT_EQ(monitor.update(extrapolated, {}, rule), TrackState::kTracking);
+    EXPECT_FALSE(monitor.last_good());
+    EXPECT_LT(monitor.last_quality(), params.min_quality);
+    EXPECT_TRUE(monitor.update(tracked, {}, rule) == TrackState::kTracking && monitor.last_good());
+  }
+  // The third and later extrapolated frames in a row count towards the loss.
+  for (int i = 0; i < 2; ++i) monitor.update(extrapolated, {}, rule);
+  EXPECT_EQ(monitor.update(extrapolated, {}, rule), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(extrapolated, {}, rule), TrackState::kTracking);
+  EXPECT_EQ(monitor.update(extrapolated, {}, rule), TrackState::kLost);
+
+  // Off: every one of them is good.
+  TrackQualityMonitor off(params);
+  off.on_initialized(Pose::Identity());
+  off.update(tracked);
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(off.update(extrapolated), TrackState::kTracking);
+  EXPECT_TRUE(off.last_good());
+  // 0: none is.
+  rule.extrapolated_good_frames = 0;
+  TrackQualityMonitor none(params);
+  none.on_initialized(Pose::Identity());
+  none.update(tracked, {}, rule);
+  none.update(extrapolated, {}, rule);
+  EXPECT_FALSE(none.last_good());
+}
+
 /// repeats_previous_find (the session's repeat_recover_diameters): while LOST a find at the
 /// previous frame's find is good whatever its score, so the track recovers after
 /// recover_after_good_frames of them; while TRACKING it changes nothing, and the colour recovery

@@ -46,6 +46,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.texture_shift_search_below, 0.0);
   EXPECT_DOUBLE_EQ(p.texture_align_below, 0.0);
   EXPECT_DOUBLE_EQ(p.surface_hold_correlation, 0.0);
+  EXPECT_EQ(p.extrapolated_good_frames, -1);
 }
 
 TEST(TrackerParams, CueFieldsAreValidated) {
@@ -63,6 +64,7 @@ TEST(TrackerParams, CueFieldsAreValidated) {
   EXPECT_TRUE(rejects("motion_velocity_smoothing", "0"));
   EXPECT_TRUE(rejects("motion_error_smoothing", "1.5"));
   EXPECT_TRUE(rejects("keypoint_motion_gate_sigmas", "-2"));
+  EXPECT_TRUE(rejects("extrapolated_good_frames", "-2"));
   EXPECT_TRUE(rejects("motion_prior_weight", "-0.1"));
   EXPECT_TRUE(rejects("region_weight", "-1"));
   EXPECT_TRUE(rejects("contour_chroma_weight", "-1"));
@@ -123,7 +125,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 106u);
+  EXPECT_EQ(fields.size(), 107u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

@@ -34,9 +34,10 @@ struct ColorEvidence {
   double surface_correlation = std::numeric_limits<double>::quiet_NaN();
 };
 
-/// When colour evidence makes a frame bad, or a bad frame is held (TrackingSession fills each
-/// field from the TrackerParams field of its name prefixed color_, e.g. color_lost_ratio, and
-/// surface_hold_correlation from the field of that name).
+/// When colour evidence makes a frame bad, or a bad frame is held, and when a run of
+/// extrapolated frames does (TrackingSession fills each field from the TrackerParams field of
+/// its name prefixed color_, e.g. color_lost_ratio, and surface_hold_correlation and
+/// extrapolated_good_frames from the fields of those names).
 struct ColorLossRule {
   /// A frame is faded (bad) when its contrast is below this x the running level (0 = never).
   double lost_ratio = 0.0;
@@ -64,6 +65,10 @@ struct ColorLossRule {
   /// surface_correlation is at least this is held: neither counted towards the loss nor good
   /// (blur lowers the contour energy and the keypoints while the printed surface still matches).
   double surface_hold_correlation = 0.0;
+  /// -1 = off. At most this many results in a row with status kExtrapolated (KLT failed) can be
+  /// good; later ones are bad (quality capped at min_quality / 2) until a result that is not
+  /// extrapolated. Not a colour rule: it applies with or without colour evidence.
+  int extrapolated_good_frames = -1;
 };
 
 /// Thresholds of the quality score and the state machine (all ours).
@@ -164,6 +169,7 @@ class TrackQualityMonitor {
   bool last_held_ = false;
   int bad_frames_ = 0;
   int good_frames_ = 0;
+  int extrapolated_frames_ = 0;  ///< results in a row with status kExtrapolated
 };
 
 }  // namespace kct

@@ -123,6 +123,11 @@ struct TrackerParams {
   /// ours (0 = off): ... and at least this share of its silhouette is inside the image
   /// (track_quality.h, ColorLossRule::recover_min_visible).
   double color_recover_min_visible = 0.0;
+  /// ours (-1 = off): at most this many frames in a row that KLT failed on (extrapolated, then
+  /// refined) can be good; later ones are bad until KLT tracks again, so a track held by the
+  /// contour alone is declared lost and re-acquired (track_quality.h,
+  /// ColorLossRule::extrapolated_good_frames).
+  int extrapolated_good_frames = -1;
   double color_accept_ratio = 0.6;      ///< re-acquire from a placement above this share
   /// Re-acquisition refines the best color_search_placements colour placements, each also
   /// turned by +-color_search_rotation_deg about the camera axes (0: not turned), and the last
