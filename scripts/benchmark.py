@@ -723,7 +723,8 @@ def run_mismatch(args, configs, runner, data, docs_dir, tmp):
     objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
     conditions = HARD_QUICK["conditions"] if args.quick else list(HARD_CONDITIONS)
     frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or HARD_FRAMES)
-    folders = {(o, c): hard_sequence(data, o, c, frames, MISMATCH_SET) for o in objects for c in conditions}
+    # Rendered inside run_hard, so that its header counts the rendering time.
+    folders = lambda: {(o, c): hard_sequence(data, o, c, frames, MISMATCH_SET) for o in objects for c in conditions}
     models = {o: (mismatched_model(data, HARD_OBJECTS[o]["model"]),
                   os.path.join(data, "models", HARD_OBJECTS[o]["model"] + ".obj")) for o in objects}
     return run_hard(args, configs, runner, data, docs_dir, tmp, set_name="mismatch", folders=folders,
@@ -1100,7 +1101,7 @@ def run_hard_variant(args, configs, runner, data, docs_dir, tmp, set_name, condi
         return generated_sequence(data, obj, os.path.join(data, set_name, obj, cond), frames, seed,
                                   backgrounds[seed % len(backgrounds)], HARD_BASE, conditions[cond][1],
                                   "rendering %s/%s/%s" % (set_name, obj, cond))
-    folders = {(o, c): sequence(o, c) for o in objects for c in chosen}
+    folders = lambda: {(o, c): sequence(o, c) for o in objects for c in chosen}  # rendered in run_hard
     return run_hard(args, configs, runner, data, docs_dir, tmp, set_name=set_name, folders=folders,
                     condition_titles=conditions, folder_frames=frames)
 
@@ -1135,7 +1136,7 @@ def run_photo(args, configs, runner, data, docs_dir, tmp):
         return ["## Photo section (path-traced)\n", "Not run: `blender` is missing (Debian package blender).\n"], []
     objects = PHOTO_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
     conditions = PHOTO_QUICK["conditions"] if args.quick else list(PHOTO_CONDITIONS)
-    folders = {(o, c): photo_sequence(data, o, c, args.repo) for o in objects for c in conditions}
+    folders = lambda: {(o, c): photo_sequence(data, o, c, args.repo) for o in objects for c in conditions}
     return run_hard(args, configs, runner, data, docs_dir, tmp, set_name="photo", folders=folders,
                     condition_titles={c: (PHOTO_CONDITIONS[c][0], PHOTO_CONDITIONS[c][2]) for c in conditions})
 
@@ -1144,11 +1145,15 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
              models=None, folder_frames=HARD_FRAMES):
     """The hard sections (and the photo and mismatch sections, given their folders of
     folder_frames frames, condition titles and models: object -> (the model the tracker is given,
-    the true one it is scored against))."""
+    the true one it is scored against)). `folders`: {(object, condition): folder}, or a function
+    returning it that renders what is missing (called here, so that the header's time
+    "generating missing data" includes it)."""
     condition_titles = condition_titles or HARD_CONDITIONS
     frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or HARD_FRAMES)
     start = datetime.datetime.now(datetime.timezone.utc)
     load_start, t0 = os.getloadavg()[0], time.time()
+    if callable(folders):
+        folders = folders()
     if folders is None:
         objects = HARD_QUICK["objects"] if args.quick else list(HARD_OBJECTS)
         conditions = HARD_QUICK["conditions"] if args.quick else list(HARD_CONDITIONS)
