@@ -1086,6 +1086,16 @@ FAR_CONDITIONS = {
 }
 
 
+def variant_sequence(data, set_name, conditions, obj, cond, frames):
+    """One sequence of a section of the hard rendering with its own conditions (run_hard_variant),
+    rendered into data/<set_name>/<obj>/<cond> unless it is there."""
+    seed = sequence_seed(set_name, obj, cond)
+    backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
+    return generated_sequence(data, obj, os.path.join(data, set_name, obj, cond), frames, seed,
+                              backgrounds[seed % len(backgrounds)], HARD_BASE, conditions[cond][1],
+                              "rendering %s/%s/%s" % (set_name, obj, cond))
+
+
 def run_hard_variant(args, configs, runner, data, docs_dir, tmp, set_name, conditions, frames,
                      quick_condition):
     """A section of the hard rendering with its own conditions (name: (title, generate_sequence
@@ -1095,13 +1105,8 @@ def run_hard_variant(args, configs, runner, data, docs_dir, tmp, set_name, condi
     chosen = [quick_condition] if args.quick else list(conditions)
     frames = HARD_QUICK["frames"] if args.quick else (args.hard_frames or frames)
 
-    def sequence(obj, cond):
-        seed = sequence_seed(set_name, obj, cond)
-        backgrounds = HARD_BACKGROUNDS.get(cond, BACKGROUNDS)
-        return generated_sequence(data, obj, os.path.join(data, set_name, obj, cond), frames, seed,
-                                  backgrounds[seed % len(backgrounds)], HARD_BASE, conditions[cond][1],
-                                  "rendering %s/%s/%s" % (set_name, obj, cond))
-    folders = lambda: {(o, c): sequence(o, c) for o in objects for c in chosen}  # rendered in run_hard
+    folders = lambda: {(o, c): variant_sequence(data, set_name, conditions, o, c, frames)  # rendered in run_hard
+                       for o in objects for c in chosen}
     return run_hard(args, configs, runner, data, docs_dir, tmp, set_name=set_name, folders=folders,
                     condition_titles=conditions, folder_frames=frames)
 

@@ -6,10 +6,10 @@ benchmark.py's own functions (auc, weighted_auc, reacquired_right_once_visible),
 figure is the benchmark's. The data are the benchmark's (`scripts/benchmark.sh --section noise`
 generates them, or `dev_loop.py generate` under the built workspace's environment).
 
-  dev_loop.py generate                                   # the hard sets and their noise draws
+  dev_loop.py generate [--long]                          # the hard sets (or the long section)
   dev_loop.py run LABEL [--binary PATH] [--draws 0,1] [--sets hard] [--objects can,toy]
                   [--conditions occlusion] [--preset realtime] [--jobs 2] [--mismatch]
-                  [--param NAME=VALUE ...] [--camera-rate 30] [--hypotheses]
+                  [--param NAME=VALUE ...] [--camera-rate 30] [--hypotheses] [--long]
   dev_loop.py compare CANDIDATE BASE                      # paired per draw, per condition, runs
   dev_loop.py reach LABEL                                 # a --hypotheses run: what re-acquisition
                                                           # had to choose from, against the truth
@@ -33,9 +33,15 @@ DATA = os.path.join(os.environ.get("KCT_DATA", os.path.join(ROOT, "data")), "ben
 DEV = os.path.join(DATA, "dev")
 
 
-def generate(_):
+def generate(a):
     for o in B.HARD_OBJECTS:
         B.ensure_model(DATA, B.HARD_OBJECTS[o]["model"])
+    if a.long:  # the long section's sequences (their draws are made by run, as links)
+        keys = [(o, c) for o in B.HARD_OBJECTS for c in B.LONG_CONDITIONS]
+        with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as ex:
+            list(ex.map(lambda k: B.variant_sequence(DATA, "long", B.LONG_CONDITIONS, k[0], k[1], B.LONG_FRAMES),
+                        keys))
+        return
 
     def one(key):
         s, o, c = key
@@ -54,8 +60,12 @@ def run(a):
     runner = B.Runner(ROOT, DATA, track_sequence=[a.binary] + (
         ["--camera-rate", "%g" % a.camera_rate] if a.camera_rate > 0 else []))
     params = dict(kv.split("=", 1) for kv in a.params)
-    jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in a.sets.split(",")
-            for o in a.objects.split(",") for c in a.conditions.split(",")]
+    # --long: the long section's sequences (300 frames; `generate --long` renders them) instead of
+    # the hard sets: what a wrong hold costs, from the same perturbed initial poses.
+    sets = ["long"] if a.long else a.sets.split(",")
+    conditions = a.conditions or ",".join(B.LONG_CONDITIONS if a.long else B.HARD_CONDITIONS)
+    jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in sets
+            for o in a.objects.split(",") for c in conditions.split(",")]
 
     # Per object: the model tracked and the one scored against (None: the same). --mismatch: the
     # mismatch section's model (3 % off the object), written once before the threads read it.
@@ -80,7 +90,7 @@ def run(a):
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
         rows = [r for r in ex.map(one, jobs) if r]
     json.dump(dict(label=a.label, binary=a.binary, preset=a.preset, params=a.params, mismatch=a.mismatch,
-                   rows=rows),
+                   long=a.long, rows=rows),
               open(os.path.join(DEV, a.label + ".json"), "w"))
     for d in sorted({r["draw"] for r in rows}):
         print("draw %d: AUC %.2f" % (d, B.weighted_auc([r for r in rows if r["draw"] == d])))
@@ -120,7 +130,7 @@ def compare(a):
                                                          B.weighted_auc(ref), mean, sd,
                                                          " ".join("%+.2f" % x for x in diffs)))
     print("re-acquired right: %d of %d, was %d of %d" % (reacquisitions(cand) + reacquisitions(ref)))
-    for c in B.HARD_CONDITIONS:
+    for c in list(B.HARD_CONDITIONS) + [c for c in B.LONG_CONDITIONS if c not in B.HARD_CONDITIONS]:
         sel = [r for r in cand if r["condition"] == c]
         if sel:
             print("  %-10s %.2f -> %.2f" % (c, B.weighted_auc([base[key(r)] for r in sel]), B.weighted_auc(sel)))
@@ -239,7 +249,8 @@ def truth(a):
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    sub.add_parser("generate")
+    g = sub.add_parser("generate")
+    g.add_argument("--long", action="store_true", help="render the long section's sequences")
     r = sub.add_parser("run")
     r.add_argument("label")
     r.add_argument("--binary", default=os.path.join(ROOT, "build", "ws", "devel", "lib", "klt_contour_tracker",
@@ -247,8 +258,10 @@ def main():
     r.add_argument("--draws", default=",".join(str(d) for d in range(B.NOISE_DRAWS)))
     r.add_argument("--sets", default=",".join(B.HARD_SETS))
     r.add_argument("--objects", default=",".join(B.HARD_OBJECTS))
-    r.add_argument("--conditions", default=",".join(B.HARD_CONDITIONS))
+    r.add_argument("--conditions", help="default: the set's all")
     r.add_argument("--preset", default="realtime")
+    r.add_argument("--long", action="store_true",
+                   help="the long section's sequences (set long, its conditions) instead of --sets")
     r.add_argument("--mismatch", action="store_true",
                    help="track with the model 3 %% off the object (the mismatch section's), scored against the true one")
     r.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
