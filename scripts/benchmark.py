@@ -86,6 +86,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_occlusion_mask", "realtime", {"occlusion_mask_radius_px": "0"}),
     # any number of frames in a row that KLT failed on can be good (the contour alone holds a track)
     ("realtime_no_extrapolated_limit", "realtime", {"extrapolated_good_frames": "-1"}),
+    # a pose at any depth can be good, and the colour search's depths follow the last good pose's
+    ("realtime_no_trusted_depth", "realtime", {"trusted_depth_ratio": "0"}),
     # while lost, a frame recovers on its contour and keypoints alone (a static distractor too)
     ("realtime_no_recovery_check", "realtime", {"color_recover_ratio": "0", "color_recover_min_visible": "0"}),
     # re-acquisition searches the whole frame (not only as far as the object could have moved)

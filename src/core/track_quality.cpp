@@ -120,7 +120,8 @@ TrackState TrackQualityMonitor::update(const TrackResult& result, const ColorEvi
   // the truth, none after the fourth frame of a run: held on the background's edges, the energy
   // level and the colour model follow the wrong pose.
   extrapolated_frames_ = result.status == TrackStatus::kExtrapolated ? extrapolated_frames_ + 1 : 0;
-  if (rule.extrapolated_good_frames >= 0 && extrapolated_frames_ > rule.extrapolated_good_frames &&
+  if (((rule.extrapolated_good_frames >= 0 && extrapolated_frames_ > rule.extrapolated_good_frames) ||
+       rule.outside_trusted_depth) &&
       last_good_) {
     last_good_ = false;
     last_quality_ = std::min(last_quality_, params_.min_quality * 0.5);

@@ -39,7 +39,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(color_keypoint_veto_inliers), KCT_FIELD(color_keypoint_veto_inlier_ratio),
       KCT_FIELD(color_vanished_ratio),
       KCT_FIELD(color_recover_ratio), KCT_FIELD(color_recover_min_visible),
-      KCT_FIELD(extrapolated_good_frames),
+      KCT_FIELD(extrapolated_good_frames), KCT_FIELD(trusted_depth_ratio),
       KCT_FIELD(color_accept_ratio),
       KCT_FIELD(color_search_placements), KCT_FIELD(color_search_rotation_deg),
       KCT_FIELD(color_search_reach_diameters),
@@ -154,6 +154,8 @@ void TrackerParams::validate() const {
   check_range(kOwner, "color_recover_ratio", color_recover_ratio, 0.0, 1.0);
   check_range(kOwner, "color_recover_min_visible", color_recover_min_visible, 0.0, 1.0);
   check_range(kOwner, "extrapolated_good_frames", extrapolated_good_frames, -1, 1000);
+  if (trusted_depth_ratio != 0.0)
+    check_range(kOwner, "trusted_depth_ratio", trusted_depth_ratio, 1.01, 100.0);
   check_range(kOwner, "repeat_recover_diameters", repeat_recover_diameters, 0.0, 1.0);
   check_range(kOwner, "repeat_recover_deg", repeat_recover_deg, 0.0, 180.0);
   check_range(kOwner, "color_accept_ratio", color_accept_ratio, 0.0, 1.0);
@@ -292,6 +294,14 @@ TrackerParams make_preset(const std::string& name) {
     // such run of wrong holds). Over 11 of these long sequences (single runs, chaotic): off
     // 7.50, 3: 7.88; 0: 7.83 (a held can in clutter 17.30 -> 14.83); 1, 2, 5: 7.08, 7.58, 7.71.
     params.extrapolated_good_frames = 3;
+    // The depth range a pose may take is 1/2-2x the trusted depth (the given pose's, then that of
+    // every good frame but the first 30 after a re-acquisition), and the colour search's depths
+    // are clipped into it: a find 3-4x too deep (the chest's own print after an occluder) was
+    // held, and each later search's depths, relative to it, went deeper still. Long section
+    // from 5 initial poses (dev_loop.py run --long, 40 runs) 7.75 -> 8.49, paired +0.75 +- 0.40,
+    // 7 runs up (castle mixed +2.8 to +5.4 in every draw), none down; re-acquired right within
+    // 10 frames of being visible 8 of 122 -> 14 of 109.
+    params.trusted_depth_ratio = 2.0;
     // Anchors laid after a KLT failure are kept only when the session judges the frame good:
     // hard section 11.14 -> 11.20 AUC, the second hard set 11.01 -> 11.38.
     params.drop_unconfirmed_anchors = true;

@@ -64,6 +64,10 @@ constexpr double kTextureCheckMinEnergyRatio = 0.9;
 /// lower by less than this x the contrast level.
 constexpr double kSameOutlineContrastTolerance = 0.1;
 
+/// trusted_depth_ratio: a re-acquired track's depth is trusted from its 30th good frame on (1 s
+/// at 30 Hz: a wrong find is usually lost again sooner).
+constexpr int kTrustAfterFrames = 30;
+
 /// The colour evidence of a scored pose.
 ColorEvidence evidence_of(const SearchCandidate& scored) {
   ColorEvidence evidence;
@@ -141,6 +145,8 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   unconfirmed_.reset();
   rotation_check_winner_ = -1;
   frames_since_doubt_ = 1000;
+  trusted_depth_m_ = (object_to_camera * tracker_->center_object()).z();
+  frames_since_recovery_ = kTrustAfterFrames;
 }
 
 void TrackingSession::reset() {
@@ -194,7 +200,7 @@ void TrackingSession::set_quality_params(const TrackQualityParams& quality) {
 TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, bool& searched,
                                        bool color_only, const SearchBar& bar) {
   searched = false;
-  const Pose& last_good = monitor_.last_good_pose();
+  const Pose last_good = search_reference();
   if (search_ && search_->ready() && !bgr.empty() &&
       monitor_.color_level() >= TrackQualityMonitor::kMinColorLevel) {
     // Hypotheses: the best colour placements, each at the last good rotation and turned by
@@ -309,6 +315,23 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   if (color_only) return TrackResult();
   if (params_.track_while_lost) return tracker_->track(frame);
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
+}
+
+Pose TrackingSession::search_reference() const {
+  Pose reference = monitor_.last_good_pose();
+  const double ratio = params_.trusted_depth_ratio;
+  const Eigen::Vector3d center = reference * tracker_->center_object();
+  if (!(ratio > 0.0) || !(trusted_depth_m_ > 0.0) || !(center.z() > 0.0)) return reference;
+  const double depth = std::clamp(center.z(), trusted_depth_m_ / ratio, trusted_depth_m_ * ratio);
+  reference.translation() += (depth / center.z() - 1.0) * center;  // along the viewing ray
+  return reference;
+}
+
+bool TrackingSession::outside_trusted_depth(const Pose& object_to_camera) const {
+  const double ratio = params_.trusted_depth_ratio;
+  if (!(ratio > 0.0) || !(trusted_depth_m_ > 0.0)) return false;
+  const double depth = (object_to_camera * tracker_->center_object()).z();
+  return !(depth >= trusted_depth_m_ / ratio && depth <= trusted_depth_m_ * ratio);
 }
 
 TrackResult TrackingSession::refine_from(const Frame& frame, const Pose& start) {
@@ -793,6 +816,8 @@ SessionResult TrackingSession::track(const Frame& frame) {
   rule.recover_min_visible = params_.color_recover_min_visible;
   rule.surface_hold_correlation = params_.surface_hold_correlation;
   rule.extrapolated_good_frames = params_.extrapolated_good_frames;
+  rule.outside_trusted_depth = result.has_pose() && result.frame.status != TrackStatus::kInitialized &&
+                               outside_trusted_depth(result.frame.object_to_camera);
   // Only a colour pattern's correlation says where the surface is (a grey object's "pattern" is
   // its shading, which a wrong pose of the castle matched at >= 0.7: hard2/castle/leave -5.5).
   if (texture_ && texture_->has_color_pattern())
@@ -810,6 +835,13 @@ SessionResult TrackingSession::track(const Frame& frame) {
   if (result.has_pose()) {
     result.quality = monitor_.last_quality();
     result.good = monitor_.last_good();
+    if (result.state == TrackState::kTracking && result.previous_state == TrackState::kLost)
+      frames_since_recovery_ = 0;
+    if (result.state == TrackState::kTracking && result.good &&
+        ++frames_since_recovery_ >= kTrustAfterFrames) {
+      const double depth = (result.frame.object_to_camera * tracker_->center_object()).z();
+      if (depth > 0.0) trusted_depth_m_ = depth;
+    }
     // Colours are learned on good frames while tracking, every color_learn_interval_frames.
     if (search_ && !bgr.empty() && result.good && result.state == TrackState::kTracking &&
         result.frame.status != TrackStatus::kInitialized &&

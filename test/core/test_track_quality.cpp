@@ -368,6 +368,26 @@ TEST(TrackQuality, OnlyTheFirstExtrapolatedFramesInARowCanBeGood) {
   EXPECT_FALSE(none.last_good());
 }
 
+/// outside_trusted_depth (the session's trusted_depth_ratio): such a frame is bad whatever its
+/// score, and counts towards the loss.
+TEST(TrackQuality, APoseOutsideTheTrustedDepthIsBad) {
+  TrackQualityParams params;
+  params.lost_after_bad_frames = 2;
+  const TrackResult tracked = refined_result(10.0, true, 1.0);
+  ColorLossRule outside;
+  outside.outside_trusted_depth = true;
+  TrackQualityMonitor monitor(params);
+  monitor.on_initialized(Pose::Identity());
+  monitor.update(tracked);
+  EXPECT_TRUE(monitor.last_good());
+  EXPECT_EQ(monitor.update(tracked, {}, outside), TrackState::kTracking);
+  EXPECT_FALSE(monitor.last_good());
+  EXPECT_LT(monitor.last_quality(), params.min_quality);
+  EXPECT_EQ(monitor.update(tracked, {}, outside), TrackState::kLost);
+  EXPECT_EQ(monitor.update(tracked, {}, ColorLossRule()), TrackState::kLost);
+  EXPECT_TRUE(monitor.last_good()) << "inside the range again: judged by its score";
+}
+
 /// repeats_previous_find (the session's repeat_recover_diameters): while LOST a find at the
 /// previous frame's find is good whatever its score, so the track recovers after
 /// recover_after_good_frames of them; while TRACKING it changes nothing, and the colour recovery

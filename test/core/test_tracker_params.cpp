@@ -47,6 +47,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.texture_align_below, 0.0);
   EXPECT_DOUBLE_EQ(p.surface_hold_correlation, 0.0);
   EXPECT_EQ(p.extrapolated_good_frames, -1);
+  EXPECT_DOUBLE_EQ(p.trusted_depth_ratio, 0.0);
 }
 
 TEST(TrackerParams, CueFieldsAreValidated) {
@@ -65,6 +66,8 @@ TEST(TrackerParams, CueFieldsAreValidated) {
   EXPECT_TRUE(rejects("motion_error_smoothing", "1.5"));
   EXPECT_TRUE(rejects("keypoint_motion_gate_sigmas", "-2"));
   EXPECT_TRUE(rejects("extrapolated_good_frames", "-2"));
+  EXPECT_TRUE(rejects("trusted_depth_ratio", "1"));
+  EXPECT_TRUE(rejects("trusted_depth_ratio", "-2"));
   EXPECT_TRUE(rejects("motion_prior_weight", "-0.1"));
   EXPECT_TRUE(rejects("region_weight", "-1"));
   EXPECT_TRUE(rejects("contour_chroma_weight", "-1"));
@@ -125,7 +128,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 107u);
+  EXPECT_EQ(fields.size(), 108u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

@@ -100,6 +100,30 @@ TEST(TrackingSession, WhileLostAMovingObjectIsTrackedFromWhereTheLastFrameEnded)
   }
 }
 
+/// trusted_depth_ratio: the trusted depth follows a good track, so a box that moves from 0.45 m
+/// to 1.0 m (2.2x, beyond the ratio 2 of the given pose's depth) stays tracked and good; a range
+/// frozen at the given pose's depth would declare the last frames bad and the track lost.
+TEST(TrackingSession, TheTrustedDepthFollowsAGoodTrack) {
+  const Scene scene;
+  const auto pose = [&](int i) { return test::move(test::make_pose(0.45), 0.0, {0, 0, 1}, {0, 0, 0.016 * i}); };
+  TrackerParams params = quick_paper();
+  params.trusted_depth_ratio = 2.0;
+  TrackingSession session(scene.mesh, params);
+  session.set_camera(scene.camera);
+  session.initialize(pose(0));
+  double stamp = 1.0;
+  SessionResult last;
+  int bad = 0;
+  for (int i = 0; i < 35; ++i, stamp += 0.033) {
+    last = session.track({test::render_frame(scene.renderer, scene.camera, pose(i), scene.background, 1.5, i), stamp});
+    bad += last.good ? 0 : 1;
+  }
+  ASSERT_GT(pose(34).translation().z(), 2.0 * 0.45) << "the box must leave the given pose's range";
+  EXPECT_EQ(last.state, TrackState::kTracking);
+  EXPECT_LE(bad, 2);
+  EXPECT_LT(translation_error(last.frame.object_to_camera, pose(34)), 0.02);
+}
+
 /// repeat_recover_diameters: the monitor is made to judge every find bad by its score (no
 /// keypoints, k = 0, caps it at 0.5 below a min_quality of 1) and KLT frames nearly always, so the
 /// session gets LOST on the box standing in plain view; every lost frame is then a find (refined

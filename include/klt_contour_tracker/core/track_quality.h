@@ -37,7 +37,7 @@ struct ColorEvidence {
 /// When colour evidence makes a frame bad, or a bad frame is held, and when a run of
 /// extrapolated frames does (TrackingSession fills each field from the TrackerParams field of
 /// its name prefixed color_, e.g. color_lost_ratio, and surface_hold_correlation and
-/// extrapolated_good_frames from the fields of those names).
+/// extrapolated_good_frames from the fields of those names; outside_trusted_depth per frame).
 struct ColorLossRule {
   /// A frame is faded (bad) when its contrast is below this x the running level (0 = never).
   double lost_ratio = 0.0;
@@ -69,6 +69,9 @@ struct ColorLossRule {
   /// good; later ones are bad (quality capped at min_quality / 2) until a result that is not
   /// extrapolated. Not a colour rule: it applies with or without colour evidence.
   int extrapolated_good_frames = -1;
+  /// This frame's pose lies outside the depth range the session trusts (TrackerParams::
+  /// trusted_depth_ratio): the frame is bad whatever its score.
+  bool outside_trusted_depth = false;
 };
 
 /// Thresholds of the quality score and the state machine (all ours).

@@ -128,6 +128,12 @@ struct TrackerParams {
   /// contour alone is declared lost and re-acquired (track_quality.h,
   /// ColorLossRule::extrapolated_good_frames).
   int extrapolated_good_frames = -1;
+  /// ours (0 = off, else > 1): a pose whose object centre is deeper than this x the trusted
+  /// depth, or nearer than the trusted depth / this, is bad; the colour search's depths are
+  /// relative to the last good pose's depth clipped into that range. The trusted depth: the
+  /// given pose's, then each good TRACKING frame's, except for the first 30 good frames after
+  /// a re-acquisition (a wrong find and the poses held from it do not move the range).
+  double trusted_depth_ratio = 0.0;
   double color_accept_ratio = 0.6;      ///< re-acquire from a placement above this share
   /// Re-acquisition refines the best color_search_placements colour placements, each also
   /// turned by +-color_search_rotation_deg about the camera axes (0: not turned), and the last

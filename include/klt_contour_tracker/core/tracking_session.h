@@ -253,6 +253,15 @@ class TrackingSession {
   /// texture_shift_search_below: the shift found on the last frame it searched, if any.
   std::optional<Eigen::Vector3d> texture_shift_winner_m_;
   int frames_since_doubt_ = 1000;  ///< frames since KLT last failed or a re-acquisition
+  /// trusted_depth_ratio: depth (m) of the object's centre at the last trusted pose, and the
+  /// good TRACKING frames since the last re-acquisition (trusted from kTrustAfterFrames on).
+  double trusted_depth_m_ = 0.0;
+  int frames_since_recovery_ = 0;
+  /// The colour search's reference pose: the last good pose, its centre moved along its viewing
+  /// ray into the trusted depth range (trusted_depth_ratio; unchanged when off).
+  Pose search_reference() const;
+  /// trusted_depth_ratio: `object_to_camera`'s centre lies outside the trusted depth range.
+  bool outside_trusted_depth(const Pose& object_to_camera) const;
   std::optional<Pose> restart_pose_;
   bool initialized_since_last_frame_ = false;
   bool has_last_stamp_ = false;
