@@ -27,7 +27,11 @@ struct Scene {
   Pose pose(int i) const {
     return test::move(test::make_pose(0.45), 0.5 * i, {0.2, 1.0, 0.0}, {0.0015 * i, -0.0005 * i, 0.0});
   }
-  cv::Mat visible(int i) const { return test::render_frame(renderer, camera, pose(i), background, 1.5, i); }
+  /// The box at `object_to_camera` on the background, noise seeded by `seed`.
+  cv::Mat render(const Pose& object_to_camera, int seed) const {
+    return test::render_frame(renderer, camera, object_to_camera, background, 1.5, seed);
+  }
+  cv::Mat visible(int i) const { return render(pose(i), i); }
   /// The object hidden: the background alone.
   cv::Mat hidden(int i) const {
     cv::Mat frame = background.clone();
@@ -86,9 +90,7 @@ TEST(TrackingSession, WhileLostAMovingObjectIsTrackedFromWhereTheLastFrameEnded)
     SessionResult last;
     int lost_frames = 0;
     for (int i = 0; i < 25; ++i, stamp += 0.033) {
-      const cv::Mat image =
-          test::render_frame(scene.renderer, scene.camera, pose(i), scene.background, 1.5, i);
-      last = session.track({image, stamp});
+      last = session.track({scene.render(pose(i), i), stamp});
       lost_frames += last.state == TrackState::kLost ? 1 : 0;
     }
     ASSERT_GE(lost_frames, 15) << "the monitor must keep the session lost";
@@ -115,7 +117,7 @@ TEST(TrackingSession, TheTrustedDepthFollowsAGoodTrack) {
   SessionResult last;
   int bad = 0;
   for (int i = 0; i < 35; ++i, stamp += 0.033) {
-    last = session.track({test::render_frame(scene.renderer, scene.camera, pose(i), scene.background, 1.5, i), stamp});
+    last = session.track({scene.render(pose(i), i), stamp});
     bad += last.good ? 0 : 1;
   }
   ASSERT_GT(pose(34).translation().z(), 2.0 * 0.45) << "the box must leave the given pose's range";
@@ -146,9 +148,7 @@ TEST(TrackingSession, AFindRepeatedWhileLostRecoversTheTrack) {
     int lost_at = -1, recovered_at = -1;
     SessionResult recovered;
     for (int i = 0; i < 30 && recovered_at < 0; ++i, stamp += 0.033) {
-      const cv::Mat image =
-          test::render_frame(scene.renderer, scene.camera, scene.pose(0), scene.background, 1.5, i);
-      const SessionResult r = session.track({image, stamp});
+      const SessionResult r = session.track({scene.render(scene.pose(0), i), stamp});
       if (lost_at < 0 && r.state == TrackState::kLost) lost_at = i;
       if (lost_at >= 0 && recovered_at < 0 && r.state == TrackState::kTracking) {
         recovered_at = i;
