@@ -6,10 +6,10 @@ benchmark.py's own functions (auc, weighted_auc, reacquired_right_once_visible),
 figure is the benchmark's. The data are the benchmark's (`scripts/benchmark.sh --section noise`
 generates them, or `dev_loop.py generate` under the built workspace's environment).
 
-  dev_loop.py generate [--long]                          # the hard sets (or the long section)
+  dev_loop.py generate [--long | --slow]                 # the hard sets (or the long / slow section)
   dev_loop.py run LABEL [--binary PATH] [--draws 0,1] [--sets hard] [--objects can,toy]
                   [--conditions occlusion] [--preset realtime] [--jobs 2] [--mismatch]
-                  [--param NAME=VALUE ...] [--camera-rate 30] [--hypotheses] [--long]
+                  [--param NAME=VALUE ...] [--camera-rate 30] [--hypotheses] [--long | --slow]
   dev_loop.py compare CANDIDATE BASE                      # paired per draw, per condition, runs
   dev_loop.py reach LABEL                                 # a --hypotheses run: what re-acquisition
                                                           # had to choose from, against the truth
@@ -42,6 +42,12 @@ def generate(a):
             list(ex.map(lambda k: B.variant_sequence(DATA, "long", B.LONG_CONDITIONS, k[0], k[1], B.LONG_FRAMES),
                         keys))
         return
+    if a.slow:  # the slow section's sequences (precision; --mismatch tracks them with the mesh off)
+        keys = [(o, c) for o in B.HARD_OBJECTS for c in B.SLOW_CONDITIONS]
+        with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as ex:
+            list(ex.map(lambda k: B.variant_sequence(DATA, "slow", B.SLOW_CONDITIONS, k[0], k[1], B.HARD_FRAMES),
+                        keys))
+        return
 
     def one(key):
         s, o, c = key
@@ -62,8 +68,11 @@ def run(a):
     params = dict(kv.split("=", 1) for kv in a.params)
     # --long: the long section's sequences (300 frames; `generate --long` renders them) instead of
     # the hard sets: what a wrong hold costs, from the same perturbed initial poses.
-    sets = ["long"] if a.long else a.sets.split(",")
-    conditions = a.conditions or ",".join(B.LONG_CONDITIONS if a.long else B.HARD_CONDITIONS)
+    # --slow: the slow section's (precision on slow footage; with --mismatch, the mesh 3 % off):
+    # the rows carry the median rotation and translation errors as well.
+    sets = ["long"] if a.long else ["slow"] if a.slow else a.sets.split(",")
+    conditions = a.conditions or ",".join(B.LONG_CONDITIONS if a.long else B.SLOW_CONDITIONS if a.slow
+                                          else B.HARD_CONDITIONS)
     jobs = [(d, s, o, c) for d in map(int, a.draws.split(",")) for s in sets
             for o in a.objects.split(",") for c in conditions.split(",")]
 
@@ -84,19 +93,29 @@ def run(a):
         if not r:  # Runner logged the failure
             return None
         B.score_visible(r, source)
+        errors = B.pose_errors(B.read_poses(r["poses_file"]), B.read_poses(os.path.join(source, "pose.txt")))
         return dict(draw=d, set=s, object=o, condition=c, auc=r["auc"], scored_frames=r["scored_frames"],
                     diameter_m=r["diameter_m"], errors=r["errors"], states=r["states"],
-                    visible_errors=r["visible_errors"], hypotheses_file=r.get("hypotheses_file"))
+                    visible_errors=r["visible_errors"], hypotheses_file=r.get("hypotheses_file"),
+                    rotation_deg=B.median([e[0] for e in errors]), translation_mm=B.median([e[1] for e in errors]))
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
         rows = [r for r in ex.map(one, jobs) if r]
     json.dump(dict(label=a.label, binary=a.binary, preset=a.preset, params=a.params, mismatch=a.mismatch,
-                   long=a.long, rows=rows),
+                   long=a.long, slow=a.slow, rows=rows),
               open(os.path.join(DEV, a.label + ".json"), "w"))
     for d in sorted({r["draw"] for r in rows}):
         print("draw %d: AUC %.2f" % (d, B.weighted_auc([r for r in rows if r["draw"] == d])))
     print("all: AUC %.2f, re-acquired right within 10 frames of being visible: %d of %d" % (
         (B.weighted_auc(rows),) + reacquisitions(rows)))
+    print("median over the runs of each run's median error: rotation %s deg, translation %s mm" % precision(rows))
     return 0 if len(rows) == len(jobs) else 1
+
+
+def precision(rows):
+    """The median over `rows` of each run's median rotation (deg) and translation (mm) error,
+    formatted ("-" for rows from before they were recorded)."""
+    return (B.fmt(B.median([r.get("rotation_deg") for r in rows])),
+            B.fmt(B.median([r.get("translation_mm") for r in rows]), 1))
 
 
 def reacquisitions(rows):
@@ -130,10 +149,15 @@ def compare(a):
                                                          B.weighted_auc(ref), mean, sd,
                                                          " ".join("%+.2f" % x for x in diffs)))
     print("re-acquired right: %d of %d, was %d of %d" % (reacquisitions(cand) + reacquisitions(ref)))
-    for c in list(B.HARD_CONDITIONS) + [c for c in B.LONG_CONDITIONS if c not in B.HARD_CONDITIONS]:
+    print("median error (rotation deg / translation mm): %s / %s, was %s / %s" % (precision(cand) + precision(ref)))
+    conditions = list(B.HARD_CONDITIONS) + [c for c in list(B.LONG_CONDITIONS) + list(B.SLOW_CONDITIONS)
+                                            if c not in B.HARD_CONDITIONS]
+    for c in conditions:
         sel = [r for r in cand if r["condition"] == c]
         if sel:
-            print("  %-10s %.2f -> %.2f" % (c, B.weighted_auc([base[key(r)] for r in sel]), B.weighted_auc(sel)))
+            print("  %-10s %.2f -> %.2f   %s / %s -> %s / %s" % (
+                (c, B.weighted_auc([base[key(r)] for r in sel]), B.weighted_auc(sel)) +
+                precision([base[key(r)] for r in sel]) + precision(sel)))
     changed = sorted((r["auc"] - base[key(r)]["auc"], key(r)) for r in cand if abs(r["auc"] - base[key(r)]["auc"]) > 0.05)
     print("runs changed: %d (%d up, %d down)" % (len(changed), sum(x > 0 for x, _ in changed),
                                                  sum(x < 0 for x, _ in changed)))
@@ -251,6 +275,7 @@ def main():
     sub = p.add_subparsers(dest="command", required=True)
     g = sub.add_parser("generate")
     g.add_argument("--long", action="store_true", help="render the long section's sequences")
+    g.add_argument("--slow", action="store_true", help="render the slow section's sequences")
     r = sub.add_parser("run")
     r.add_argument("label")
     r.add_argument("--binary", default=os.path.join(ROOT, "build", "ws", "devel", "lib", "klt_contour_tracker",
@@ -262,6 +287,9 @@ def main():
     r.add_argument("--preset", default="realtime")
     r.add_argument("--long", action="store_true",
                    help="the long section's sequences (set long, its conditions) instead of --sets")
+    r.add_argument("--slow", action="store_true",
+                   help="the slow section's sequences (set slow, its conditions): precision; with --mismatch, "
+                        "the mesh 3 %% off")
     r.add_argument("--mismatch", action="store_true",
                    help="track with the model 3 %% off the object (the mismatch section's), scored against the true one")
     r.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
