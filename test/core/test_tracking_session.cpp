@@ -2,6 +2,9 @@
 // jump behind one track() call. A coarse visibility table keeps the test quick.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <vector>
+
 #include <opencv2/imgproc.hpp>
 
 #include "klt_contour_tracker/core/tracking_session.h"
@@ -32,6 +35,16 @@ struct Scene {
     return test::render_frame(renderer, camera, object_to_camera, background, 1.5, seed);
   }
   cv::Mat visible(int i) const { return render(pose(i), i); }
+  /// `session` initialized at path(0), then frames 0 .. frames - 1 rendered at path(i) (noise
+  /// seed i), stamped 1.0 s + i x 0.033 s and tracked: their results.
+  template <typename Path>
+  std::vector<SessionResult> follow(TrackingSession& session, const Path& path, int frames) const {
+    session.initialize(path(0));
+    std::vector<SessionResult> results;
+    double stamp = 1.0;
+    for (int i = 0; i < frames; ++i, stamp += 0.033) results.push_back(session.track({render(path(i), i), stamp}));
+    return results;
+  }
   /// The object hidden: the background alone.
   cv::Mat hidden(int i) const {
     cv::Mat frame = background.clone();
@@ -85,16 +98,12 @@ TEST(TrackingSession, WhileLostAMovingObjectIsTrackedFromWhereTheLastFrameEnded)
     params.track_while_lost = track_while_lost;
     TrackingSession session(scene.mesh, params, quality);
     session.set_camera(scene.camera);
-    session.initialize(pose(0));
-    double stamp = 1.0;
-    SessionResult last;
-    int lost_frames = 0;
-    for (int i = 0; i < 25; ++i, stamp += 0.033) {
-      last = session.track({scene.render(pose(i), i), stamp});
-      lost_frames += last.state == TrackState::kLost ? 1 : 0;
-    }
+    const std::vector<SessionResult> results = scene.follow(session, pose, 25);
+    const auto lost_frames = std::count_if(results.begin(), results.end(), [](const SessionResult& r) {
+      return r.state == TrackState::kLost;
+    });
     ASSERT_GE(lost_frames, 15) << "the monitor must keep the session lost";
-    const double error_m = translation_error(last.frame.object_to_camera, pose(24));
+    const double error_m = translation_error(results.back().frame.object_to_camera, pose(24));
     if (track_while_lost)
       EXPECT_LT(error_m, 0.005) << "followed while lost";
     else
@@ -112,14 +121,9 @@ TEST(TrackingSession, TheTrustedDepthFollowsAGoodTrack) {
   params.trusted_depth_ratio = 2.0;
   TrackingSession session(scene.mesh, params);
   session.set_camera(scene.camera);
-  session.initialize(pose(0));
-  double stamp = 1.0;
-  SessionResult last;
-  int bad = 0;
-  for (int i = 0; i < 35; ++i, stamp += 0.033) {
-    last = session.track({scene.render(pose(i), i), stamp});
-    bad += last.good ? 0 : 1;
-  }
+  const std::vector<SessionResult> results = scene.follow(session, pose, 35);
+  const SessionResult& last = results.back();
+  const auto bad = std::count_if(results.begin(), results.end(), [](const SessionResult& r) { return !r.good; });
   ASSERT_GT(pose(34).translation().z(), 2.0 * 0.45) << "the box must leave the given pose's range";
   EXPECT_EQ(last.state, TrackState::kTracking);
   EXPECT_LE(bad, 2);
