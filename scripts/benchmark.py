@@ -1180,9 +1180,9 @@ def pose_errors(estimated, truth):
         if estimated[i] is None or truth[i] is None:
             continue
         (ra, ta), (rb, tb) = estimated[i], truth[i]
-        cosine = (sum(a * b for a, b in zip(ra, rb)) - 1.0) / 2.0  # trace(Ra^T Rb) = sum Ra_ij Rb_ij
         if not all(math.isfinite(x) for x in ra + ta):
             continue
+        cosine = (sum(a * b for a, b in zip(ra, rb)) - 1.0) / 2.0  # trace(Ra^T Rb) = sum Ra_ij Rb_ij
         rotation = math.degrees(math.acos(max(-1.0, min(1.0, cosine))))
         out.append((rotation, 1000.0 * math.sqrt(sum((a - b) ** 2 for a, b in zip(ta, tb)))))
     return out
