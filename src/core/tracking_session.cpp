@@ -145,7 +145,7 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   unconfirmed_.reset();
   rotation_check_winner_ = -1;
   frames_since_doubt_ = 1000;
-  trusted_depth_m_ = (object_to_camera * tracker_->center_object()).z();
+  trusted_depth_m_ = center_depth_m(object_to_camera);
   frames_since_recovery_ = kTrustAfterFrames;
 }
 
@@ -327,10 +327,14 @@ Pose TrackingSession::search_reference() const {
   return reference;
 }
 
+double TrackingSession::center_depth_m(const Pose& object_to_camera) const {
+  return (object_to_camera * tracker_->center_object()).z();
+}
+
 bool TrackingSession::outside_trusted_depth(const Pose& object_to_camera) const {
   const double ratio = params_.trusted_depth_ratio;
   if (!(ratio > 0.0) || !(trusted_depth_m_ > 0.0)) return false;
-  const double depth = (object_to_camera * tracker_->center_object()).z();
+  const double depth = center_depth_m(object_to_camera);
   return !(depth >= trusted_depth_m_ / ratio && depth <= trusted_depth_m_ * ratio);
 }
 
@@ -405,7 +409,7 @@ bool TrackingSession::within_reach(const Pose& object_to_camera, double reach_px
 double TrackingSession::search_reach_px() const {
   if (!(params_.color_search_reach_diameters > 0.0)) return 0.0;
   const Pose& last_good = monitor_.last_good_pose();
-  const double depth_m = (last_good * tracker_->center_object()).z();
+  const double depth_m = center_depth_m(last_good);
   if (!(depth_m > 0.0)) return 0.0;
   // This frame is consecutive_bad_frames() + 1 frames after the last good one.
   return params_.color_search_reach_diameters * (monitor_.consecutive_bad_frames() + 1) *
@@ -839,7 +843,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
       frames_since_recovery_ = 0;
     if (result.state == TrackState::kTracking && result.good &&
         ++frames_since_recovery_ >= kTrustAfterFrames) {
-      const double depth = (result.frame.object_to_camera * tracker_->center_object()).z();
+      const double depth = center_depth_m(result.frame.object_to_camera);
       if (depth > 0.0) trusted_depth_m_ = depth;
     }
     // Colours are learned on good frames while tracking, every color_learn_interval_frames.

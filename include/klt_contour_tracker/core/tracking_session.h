@@ -260,6 +260,8 @@ class TrackingSession {
   /// The colour search's reference pose: the last good pose, its centre moved along its viewing
   /// ray into the trusted depth range (trusted_depth_ratio; unchanged when off).
   Pose search_reference() const;
+  /// Depth (m, along the camera axis) of the object's centre at `object_to_camera`.
+  double center_depth_m(const Pose& object_to_camera) const;
   /// trusted_depth_ratio: `object_to_camera`'s centre lies outside the trusted depth range.
   bool outside_trusted_depth(const Pose& object_to_camera) const;
   std::optional<Pose> restart_pose_;
