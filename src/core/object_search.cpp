@@ -15,6 +15,18 @@ namespace kct {
 namespace {
 
 constexpr const char* kOwner = "ObjectSearchSettings";
+/// A placement the contrast map does not score (too little of it in the image, or out of reach).
+constexpr float kNotScored = -2.0f;
+/// Coarse to fine: the search areas (centres, working px) from which the coarse level is used
+/// (a tracked search's small window is correlated at the working size at once), ...
+constexpr int kCoarseMinCentres = 48 * 48;
+/// ... the smallest object (radius at the working size, px) that still shows at half size, ...
+constexpr double kCoarseMinRadiusPx = 12.0;
+/// ... how many of the coarse map's peaks are searched again at the working size (different
+/// places, at least a quarter of the object's radius apart), ...
+constexpr int kCoarsePeaks = 3;
+/// ... and how far around each (working px): a coarse pixel covers 2 x 2, plus a pixel of slack.
+constexpr double kFineReachPx = 2.5;
 
 int ring_width_px(const cv::Mat& mask, double fraction) {
   const cv::Rect box = cv::boundingRect(mask);
@@ -258,6 +270,74 @@ cv::Mat silhouette_ring(const cv::Mat& mask, int ring_px) {
   return dilated & ~mask;
 }
 
+cv::Mat ObjectSearch::contrast_map(const cv::Mat& posterior, const PinholeCamera& working_camera,
+                                   const Pose& reference, double depth_m, const cv::Rect& centres,
+                                   cv::Mat& visible) const {
+  visible.release();
+  // The silhouette on a square canvas with the object's centre at the canvas centre.
+  const double radius_px = working_camera.fx() * 0.5 * diameter_m_ / depth_m;
+  const int ring_guess =
+      std::max(2, static_cast<int>(std::ceil(settings_.ring_fraction * 2.0 * radius_px)));
+  const int half = static_cast<int>(std::ceil(radius_px)) + ring_guess + 2;
+  const int side = 2 * half + 1;
+  if (side > 4 * std::max(posterior.cols, posterior.rows) || side < 5) return cv::Mat();
+  const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(), half, half, side,
+                                    side);
+  const Pose centred =
+      placed_at(reference, center_object_, canvas_camera, Eigen::Vector2d(half, half), depth_m);
+  const cv::Mat mask = renderer_.render_silhouette(centred, canvas_camera);
+  const double area = cv::countNonZero(mask);
+  if (area < 4) return cv::Mat();
+  const cv::Mat ring = silhouette_ring(mask, ring_width_px(mask, settings_.ring_fraction));
+  cv::Mat inside_template, ring_template;
+  mask.convertTo(inside_template, CV_32F, 1.0 / 255.0);
+  ring.convertTo(ring_template, CV_32F, 1.0 / 255.0);
+  // Placements reaching outside the image: the posterior padded with zeros, so sums count
+  // only pixels inside it. The areas inside the image are the templates' sums over their
+  // overlap with the image rectangle: read from integral images, not correlated.
+  // Template top-left at padded (c, r) centres it on image pixel (c, r); only the window the
+  // centres need is padded and correlated.
+  cv::Mat window;
+  const cv::Rect needed(centres.x - half, centres.y - half, centres.width + side - 1,
+                        centres.height + side - 1);
+  const cv::Rect inside = needed & cv::Rect(0, 0, posterior.cols, posterior.rows);
+  cv::copyMakeBorder(posterior(inside), window, inside.y - needed.y,
+                     needed.br().y - inside.br().y, inside.x - needed.x,
+                     needed.br().x - inside.br().x, cv::BORDER_CONSTANT, 0);
+  cv::Mat posterior_inside, posterior_ring;  // index (c, r): centre centres.tl() + (c, r)
+  cv::matchTemplate(window, inside_template, posterior_inside, cv::TM_CCORR);
+  cv::matchTemplate(window, ring_template, posterior_ring, cv::TM_CCORR);
+  cv::Mat inside_integral, ring_integral;
+  cv::integral(mask / 255, inside_integral, CV_32S);
+  cv::integral(ring / 255, ring_integral, CV_32S);
+  // Template pixels of the placement centred on image pixel (c, r) that fall in the image.
+  auto in_image = [&](const cv::Mat& integral, int r, int c) {
+    const int j0 = std::max(0, half - r), j1 = std::min(side, half - r + posterior.rows);
+    const int i0 = std::max(0, half - c), i1 = std::min(side, half - c + posterior.cols);
+    if (j0 >= j1 || i0 >= i1) return 0.0f;
+    return static_cast<float>(integral.at<int>(j1, i1) - integral.at<int>(j0, i1) -
+                              integral.at<int>(j1, i0) + integral.at<int>(j0, i0));
+  };
+  const float min_area = static_cast<float>(settings_.min_visible_fraction * area);
+  cv::Mat contrast(posterior_inside.size(), CV_32F, cv::Scalar(kNotScored));
+  visible = cv::Mat(posterior_inside.size(), CV_32F, cv::Scalar(0.0f));
+  for (int r = 0; r < contrast.rows; ++r) {
+    const float* pi = posterior_inside.ptr<float>(r);
+    const float* pr = posterior_ring.ptr<float>(r);
+    float* out = contrast.ptr<float>(r);
+    float* shown = visible.ptr<float>(r);
+    for (int c = 0; c < contrast.cols; ++c) {
+      const int u = centres.x + c, v = centres.y + r;  // image pixel
+      const float area_inside = in_image(inside_integral, v, u);
+      const float area_ring = in_image(ring_integral, v, u);
+      shown[c] = static_cast<float>(std::min(1.0, area_inside / area));
+      if (area_inside < min_area || area_ring < 1.0f) continue;
+      out[c] = pi[c] / area_inside - pr[c] / area_ring;
+    }
+  }
+  return contrast;
+}
+
 std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose& reference,
                                                   const PinholeCamera& camera,
                                                   double reach_px) const {
@@ -267,97 +347,126 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
   PinholeCamera working_camera;
   const cv::Mat small = working_image(bgr, camera, working_camera);
   const cv::Mat posterior = posterior_map(small);
-  // The reach around the reference's centre, in working-image px (squared; 0: anywhere).
+  // The coarse level: the posterior at half the working size (each pixel the mean of 2 x 2),
+  // correlated first over the whole search area, its best peaks then placed at the working size.
+  cv::Mat coarse_posterior;
+  PinholeCamera coarse_camera;
+  const bool coarse = settings_.coarse_to_fine && small.cols >= 64 && small.rows >= 64;
+  if (coarse) {
+    const cv::Size size((small.cols + 1) / 2, (small.rows + 1) / 2);
+    cv::resize(posterior, coarse_posterior, size, 0, 0, cv::INTER_AREA);
+    const double sx = static_cast<double>(size.width) / small.cols;
+    const double sy = static_cast<double>(size.height) / small.rows;
+    coarse_camera = PinholeCamera(working_camera.fx() * sx, working_camera.fy() * sy,
+                                  (working_camera.cx() + 0.5) * sx - 0.5,
+                                  (working_camera.cy() + 0.5) * sy - 0.5, size.width, size.height);
+  }
+  // The reach around the reference's centre, in working-image px (0: anywhere).
   const Eigen::Vector2d reference_px = working_camera.project(reference * center_object_);
-  const double reach_working = reach_px * working_camera.fx() / camera.fx();
-  const double reach2 = reach_px > 0.0 ? reach_working * reach_working : 0.0;
+  const double reach_working = reach_px > 0.0 ? reach_px * working_camera.fx() / camera.fx() : 0.0;
+  // The centres (image pixels of `image`) within the reach, or every pixel; empty when none.
+  const auto centres_within = [&](const cv::Mat& image, const Eigen::Vector2d& centre_px,
+                                  double reach) {
+    cv::Rect centres(0, 0, image.cols, image.rows);
+    if (!(reach > 0.0)) return centres;
+    const double x0 = std::floor(centre_px.x() - reach), y0 = std::floor(centre_px.y() - reach);
+    const double x1 = std::ceil(centre_px.x() + reach), y1 = std::ceil(centre_px.y() + reach);
+    if (!(x1 >= 0.0 && y1 >= 0.0 && x0 < image.cols && y0 < image.rows)) return cv::Rect();
+    const int left = static_cast<int>(std::max(0.0, x0)), top = static_cast<int>(std::max(0.0, y0));
+    return centres & cv::Rect(left, top,
+                              static_cast<int>(std::min<double>(image.cols - 1, x1)) - left + 1,
+                              static_cast<int>(std::min<double>(image.rows - 1, y1)) - top + 1);
+  };
+  // A contrast map's `count` best scored centres within the reach, best first, each at least
+  // `suppress_px` (in both directions) from the ones before (fewer when fewer are scored).
+  struct Peak {
+    cv::Point at;  ///< image pixel
+    float contrast;
+    float visible_fraction;
+  };
+  const auto peaks = [](const cv::Mat& contrast, const cv::Mat& visible, const cv::Rect& centres,
+                        const Eigen::Vector2d& centre_px, double reach, int count,
+                        int suppress_px) {
+    const double reach2 = reach > 0.0 ? reach * reach : 0.0;
+    cv::Mat scores = contrast.clone();
+    if (reach2 > 0.0)
+      for (int r = 0; r < scores.rows; ++r) {
+        float* s = scores.ptr<float>(r);
+        for (int c = 0; c < scores.cols; ++c)
+          if ((Eigen::Vector2d(centres.x + c, centres.y + r) - centre_px).squaredNorm() > reach2)
+            s[c] = kNotScored;
+      }
+    std::vector<Peak> found;
+    for (int k = 0; k < count; ++k) {
+      // The first maximum in row-major order (ties: the same pixel whatever the thread count).
+      float best = kNotScored;
+      cv::Point best_at(-1, -1);
+      for (int r = 0; r < scores.rows; ++r) {
+        const float* s = scores.ptr<float>(r);
+        for (int c = 0; c < scores.cols; ++c)
+          if (s[c] > best) {
+            best = s[c];
+            best_at = {c, r};
+          }
+      }
+      if (best_at.x < 0) break;
+      found.push_back({best_at + centres.tl(), best, visible.at<float>(best_at)});
+      cv::rectangle(scores, best_at - cv::Point(suppress_px, suppress_px),
+                    best_at + cv::Point(suppress_px, suppress_px), cv::Scalar(kNotScored),
+                    cv::FILLED);
+    }
+    return found;
+  };
   // One candidate per depth, each depth on its own (the order kept: a tie sorts the same way
   // whatever the thread count).
   std::vector<std::optional<SearchCandidate>> per_depth(settings_.depth_scales.size());
   workers_->parallel_for(static_cast<int>(per_depth.size()), [&](int d) {
-    const double scale = settings_.depth_scales[static_cast<std::size_t>(d)];
-    const double depth_m = reference_depth * scale;
-    // The silhouette on a square canvas with the object's centre at the canvas centre.
+    const double depth_m = reference_depth * settings_.depth_scales[static_cast<std::size_t>(d)];
     const double radius_px = working_camera.fx() * 0.5 * diameter_m_ / depth_m;
-    const int ring_guess = std::max(2, static_cast<int>(std::ceil(settings_.ring_fraction * 2.0 * radius_px)));
-    const int half = static_cast<int>(std::ceil(radius_px)) + ring_guess + 2;
-    const int side = 2 * half + 1;
-    if (side > 4 * std::max(small.cols, small.rows) || side < 5) return;
-    const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(), half, half, side,
-                                      side);
-    const Pose centred = placed_at(reference, center_object_, canvas_camera,
-                                   Eigen::Vector2d(half, half), depth_m);
-    const cv::Mat mask = renderer_.render_silhouette(centred, canvas_camera);
-    const double area = cv::countNonZero(mask);
-    if (area < 4) return;
-    const cv::Mat ring = silhouette_ring(mask, ring_width_px(mask, settings_.ring_fraction));
-    cv::Mat inside_template, ring_template;
-    mask.convertTo(inside_template, CV_32F, 1.0 / 255.0);
-    ring.convertTo(ring_template, CV_32F, 1.0 / 255.0);
-    // Placements reaching outside the image: the posterior padded with zeros, so sums count
-    // only pixels inside it. The areas inside the image are the templates' sums over their
-    // overlap with the image rectangle: read from integral images, not correlated.
-    cv::Mat padded_posterior;
-    cv::copyMakeBorder(posterior, padded_posterior, half, half, half, half, cv::BORDER_CONSTANT, 0);
-    // The centres searched: every image pixel, or those within the reach (a tracked search
-    // keeps to a fraction of a diameter: correlating the whole frame would cost most of it).
-    cv::Rect centres(0, 0, small.cols, small.rows);
-    if (reach2 > 0.0) {
-      const double x0 = std::floor(reference_px.x() - reach_working);
-      const double y0 = std::floor(reference_px.y() - reach_working);
-      const double x1 = std::ceil(reference_px.x() + reach_working);
-      const double y1 = std::ceil(reference_px.y() + reach_working);
-      if (!(x1 >= 0.0 && y1 >= 0.0 && x0 < small.cols && y0 < small.rows)) return;
-      const int left = static_cast<int>(std::max(0.0, x0)),
-                top = static_cast<int>(std::max(0.0, y0));
-      centres &=
-          cv::Rect(left, top, static_cast<int>(std::min<double>(small.cols - 1, x1)) - left + 1,
-                   static_cast<int>(std::min<double>(small.rows - 1, y1)) - top + 1);
-      if (centres.empty()) return;
-    }
-    // Template top-left at padded (c, r) centres it on image pixel (c, r).
-    const cv::Mat window = padded_posterior(
-        cv::Rect(centres.x, centres.y, centres.width + side - 1, centres.height + side - 1));
-    cv::Mat posterior_inside, posterior_ring;  // index (c, r): centre centres.tl() + (c, r)
-    cv::matchTemplate(window, inside_template, posterior_inside, cv::TM_CCORR);
-    cv::matchTemplate(window, ring_template, posterior_ring, cv::TM_CCORR);
-    cv::Mat inside_integral, ring_integral;
-    cv::integral(mask / 255, inside_integral, CV_32S);
-    cv::integral(ring / 255, ring_integral, CV_32S);
-    // Template pixels of the placement centred on image pixel (c, r) that fall in the image.
-    auto in_image = [&](const cv::Mat& integral, int r, int c) {
-      const int j0 = std::max(0, half - r), j1 = std::min(side, half - r + small.rows);
-      const int i0 = std::max(0, half - c), i1 = std::min(side, half - c + small.cols);
-      if (j0 >= j1 || i0 >= i1) return 0.0f;
-      return static_cast<float>(integral.at<int>(j1, i1) - integral.at<int>(j0, i1) -
-                                integral.at<int>(j1, i0) + integral.at<int>(j0, i0));
-    };
-    const float min_area = static_cast<float>(settings_.min_visible_fraction * area);
-    double best = -2.0;
-    cv::Point best_at(-1, -1);
-    for (int r = 0; r < posterior_inside.rows; ++r) {
-      const float* pi = posterior_inside.ptr<float>(r);
-      const float* pr = posterior_ring.ptr<float>(r);
-      for (int c = 0; c < posterior_inside.cols; ++c) {
-        const int u = centres.x + c, v = centres.y + r;  // image pixel
-        const float area_inside = in_image(inside_integral, v, u);
-        const float area_ring = in_image(ring_integral, v, u);
-        if (area_inside < min_area || area_ring < 1.0f) continue;
-        if (reach2 > 0.0 && (Eigen::Vector2d(u, v) - reference_px).squaredNorm() > reach2) continue;
-        const double contrast = pi[c] / area_inside - pr[c] / area_ring;
-        if (contrast > best) {
-          best = contrast;
-          best_at = {u, v};
-        }
+    const cv::Rect centres = centres_within(small, reference_px, reach_working);
+    if (centres.empty()) return;
+    std::vector<Peak> found;
+    cv::Mat visible;
+    // Coarse to fine when the area searched is large and the object large enough to show at
+    // half size: the coarse map's best peaks, each searched again at the working size within
+    // kFineReachPx (the coarse pixel's footprint and a pixel of slack).
+    if (coarse && centres.area() > kCoarseMinCentres && radius_px >= kCoarseMinRadiusPx) {
+      const Eigen::Vector2d coarse_reference = coarse_camera.project(reference * center_object_);
+      const double coarse_reach = reach_working * coarse_camera.fx() / working_camera.fx();
+      const cv::Rect coarse_centres = centres_within(coarse_posterior, coarse_reference, coarse_reach);
+      if (coarse_centres.empty()) return;
+      cv::Mat coarse_visible;
+      const cv::Mat coarse_map = contrast_map(coarse_posterior, coarse_camera, reference, depth_m,
+                                              coarse_centres, coarse_visible);
+      if (coarse_map.empty()) return;
+      const int suppress = std::max(2, static_cast<int>(0.25 * radius_px * coarse_camera.fx() /
+                                                        working_camera.fx()));
+      for (const Peak& p : peaks(coarse_map, coarse_visible, coarse_centres, coarse_reference, coarse_reach,
+                                 kCoarsePeaks, suppress)) {
+        const Eigen::Vector2d fine_px(2.0 * p.at.x + 0.5, 2.0 * p.at.y + 0.5);
+        const cv::Rect fine_centres =
+            centres_within(small, fine_px, kFineReachPx) & centres;
+        if (fine_centres.empty()) continue;
+        const cv::Mat fine_map =
+            contrast_map(posterior, working_camera, reference, depth_m, fine_centres, visible);
+        if (fine_map.empty()) continue;
+        for (const Peak& q : peaks(fine_map, visible, fine_centres, reference_px, reach_working, 1, 0))
+          found.push_back(q);
       }
+    } else {
+      const cv::Mat map = contrast_map(posterior, working_camera, reference, depth_m, centres, visible);
+      if (map.empty()) return;
+      found = peaks(map, visible, centres, reference_px, reach_working, 1, 0);
     }
-    if (best_at.x < 0) return;
+    if (found.empty()) return;
+    const Peak best = *std::max_element(found.begin(), found.end(), [](const Peak& a, const Peak& b) {
+      return a.contrast < b.contrast;
+    });
     SearchCandidate candidate;
     candidate.object_to_camera = placed_at(reference, center_object_, working_camera,
-                                           Eigen::Vector2d(best_at.x, best_at.y), depth_m);
-    candidate.contrast = best;
-    candidate.visible_fraction =
-        std::min(1.0, in_image(inside_integral, best_at.y, best_at.x) / area);
+                                           Eigen::Vector2d(best.at.x, best.at.y), depth_m);
+    candidate.contrast = best.contrast;
+    candidate.visible_fraction = best.visible_fraction;
     per_depth[static_cast<std::size_t>(d)] = candidate;
   });
   for (const auto& candidate : per_depth)

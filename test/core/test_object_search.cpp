@@ -240,6 +240,41 @@ TEST_F(ObjectSearchTest, AReachAtTheImageBorderFindsWhatTheWholeFrameFinds) {
   EXPECT_TRUE(search.search(frame, centred_at_x(-200.0), camera_, 60.0).empty());
 }
 
+TEST_F(ObjectSearchTest, CoarseToFineFindsWhatTheWorkingSizeFinds) {
+  // The coarse level only chooses where to look at the working size: on a moved object, one
+  // entering the image and a scene with a weaker twin, both searches give the same placements.
+  ObjectSearchSettings working_only;
+  working_only.coarse_to_fine = false;
+  ObjectSearch coarse(mesh_), fine(mesh_, working_only);
+  ASSERT_TRUE(coarse.settings().coarse_to_fine);
+  const Pose learned_at = test::make_pose(0.4);
+  ASSERT_TRUE(coarse.learn(frame_at(learned_at), learned_at, camera_));
+  ASSERT_TRUE(fine.learn(frame_at(learned_at), learned_at, camera_));
+  const Eigen::Vector3d c = mesh_->bounding_box_center();
+  Pose entering = learned_at;
+  const Eigen::Vector3d centre = learned_at * c;
+  entering.translation().x() += (20.0 - camera_.cx()) * centre.z() / camera_.fx() - centre.x();
+  cv::Mat twins = frame_at(test::move(learned_at, 0, Eigen::Vector3d::UnitZ(), {-0.15, 0.0, 0.0}));
+  const Pose weaker = test::move(learned_at, 20, Eigen::Vector3d::UnitY(), {0.1, 0.02, 0.0});
+  frame_at(weaker).copyTo(twins, renderer_->render(weaker, camera_).mask());
+  const std::vector<cv::Mat> frames{
+      frame_at(test::move(learned_at, 10, Eigen::Vector3d(0.3, 1.0, 0.2), {0.12, 0.06, 0.08})),
+      frame_at(entering), twins};
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    const std::vector<SearchCandidate> a = coarse.search(frames[f], learned_at, camera_);
+    const std::vector<SearchCandidate> b = fine.search(frames[f], learned_at, camera_);
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_FALSE(a.empty());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_LT((camera_.project(a[i].object_to_camera * c) - camera_.project(b[i].object_to_camera * c)).norm(),
+                1e-6);
+      EXPECT_NEAR(a[i].contrast, b[i].contrast, 1e-6);
+      EXPECT_NEAR(a[i].visible_fraction, b[i].visible_fraction, 1e-6);
+    }
+  }
+}
+
 TEST_F(ObjectSearchTest, GreyFramesStoredAsColourAreRecognized) {
   const cv::Mat colour = frame_at(test::make_pose(0.4));
   EXPECT_FALSE(ObjectSearch::looks_grey(colour));

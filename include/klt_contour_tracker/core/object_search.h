@@ -10,6 +10,9 @@
 /// template, with the frame's per-pixel foreground posterior (cv::matchTemplate): the score of a
 /// placement is the mean posterior inside the silhouette minus the mean in a ring around it, over
 /// the pixels in the image, so an object entering the image is found once part of it is in.
+/// Coarse to fine: the whole frame is correlated at half the working size and its best peaks
+/// again at the working size around them (matchTemplate over the whole working frame was a
+/// quarter of a lost frame's time).
 
 #include <memory>
 #include <opencv2/core.hpp>
@@ -36,6 +39,9 @@ struct ObjectSearchSettings {
   double min_visible_fraction = 0.3;
   /// Width of the ring around the silhouette, as a fraction of its larger side (at least 2 px).
   double ring_fraction = 0.15;
+  /// Correlate at half the working size first, then search the best coarse peaks again at the
+  /// working size (a third of the work of a whole-frame search); false: the working size only.
+  bool coarse_to_fine = true;
   /// Threads in all, the caller's included, for the depths of a search and the poses of a
   /// score (results do not depend on it), [1, 64].
   int threads = 1;
@@ -108,6 +114,14 @@ class ObjectSearch {
   /// bounding box with room for the ring, within one image size around the image.
   cv::Rect silhouette_canvas(const Pose& object_to_camera,
                              const PinholeCamera& working_camera) const;
+  /// The contrast of the silhouette of `reference`'s rotation at `depth_m`, centred on each
+  /// pixel of `centres` of `posterior` (seen by `working_camera`): CV_32F, indexed from
+  /// centres.tl(), kNotScored where less than min_visible_fraction of it or none of its ring is in
+  /// the image; `visible` gets the share of the silhouette in the image. Empty when the
+  /// silhouette is too small or too large to correlate.
+  cv::Mat contrast_map(const cv::Mat& posterior, const PinholeCamera& working_camera,
+                       const Pose& reference, double depth_m, const cv::Rect& centres,
+                       cv::Mat& visible) const;
   /// Per-pixel P(foreground | colour) of a working-size image, CV_32F.
   cv::Mat posterior_map(const cv::Mat& working_bgr) const;
 
