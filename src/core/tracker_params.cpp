@@ -42,6 +42,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(extrapolated_good_frames), KCT_FIELD(trusted_depth_ratio),
       KCT_FIELD(color_accept_ratio),
       KCT_FIELD(color_search_placements), KCT_FIELD(color_search_rotation_deg),
+      KCT_FIELD(color_search_refined),
       KCT_FIELD(color_search_reach_diameters),
       KCT_FIELD(color_confirm_ratio), KCT_FIELD(drop_unconfirmed_anchors),
       KCT_FIELD(track_while_lost), KCT_FIELD(repeat_recover_diameters), KCT_FIELD(repeat_recover_deg),
@@ -161,6 +162,7 @@ void TrackerParams::validate() const {
   check_range(kOwner, "color_accept_ratio", color_accept_ratio, 0.0, 1.0);
   check_range(kOwner, "color_search_placements", color_search_placements, 1, 5);
   check_range(kOwner, "color_search_rotation_deg", color_search_rotation_deg, 0.0, 90.0);
+  check_range(kOwner, "color_search_refined", color_search_refined, 0, 1000);
   check_range(kOwner, "color_search_reach_diameters", color_search_reach_diameters, 0.0, 100.0);
   check_range(kOwner, "color_confirm_ratio", color_confirm_ratio, 0.0, 1.0);
   check_range(kOwner, "motion_velocity_smoothing", motion_velocity_smoothing, 1e-6, 1.0);
@@ -256,6 +258,10 @@ TrackerParams make_preset(const std::string& name) {
     params.color_accept_ratio = 0.8;
     params.color_search_placements = 3;
     params.color_search_rotation_deg = 30.0;
+    // Of its 21 placements and turns, the 8 of best colour contrast are refined: dev loop
+    // (both hard sets, 5 draws) 14.30 against 14.29 for all 21 (+0.02 +- 0.13), lost frames
+    // about 10 % faster.
+    params.color_search_refined = 8;
     // A weaker placement (>= 0.5 x the level) is taken when two frames agree on it: hard
     // section 11.05 -> 11.25 AUC (occlusion 3.44 -> 3.78, the chest behind the occluder
     // 1.75 -> 4.12: re-acquired after blur instead of never).

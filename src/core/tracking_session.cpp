@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 #include "klt_contour_tracker/core/elapsed.h"
@@ -247,6 +248,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
             0.05 * tracker_->diameter_m())
       hypotheses.push_back(last);
     const double angle = params_.color_search_rotation_deg * M_PI / 180.0;
+    const std::size_t first_placed = hypotheses.size();
     for (const SearchCandidate& candidate : found) {
       const Pose& placed = candidate.object_to_camera;
       hypotheses.push_back(placed);
@@ -254,6 +256,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
       for (const Pose& turned : turned_about_center(placed, center_object, angle))
         hypotheses.push_back(turned);
     }
+    keep_best_placements(bgr, first_placed, hypotheses);
     std::vector<TrackResult> refined = refine_once(frame, hypotheses);
     if (refined.front().status != TrackStatus::kReacquired) return refined.front();  // invalid frame
     std::vector<Pose> refined_poses;
@@ -315,6 +318,25 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
   if (color_only) return TrackResult();
   if (params_.track_while_lost) return tracker_->track(frame);
   return tracker_->reacquire(frame, last_good, monitor_.params().reacquire_search_scale);
+}
+
+void TrackingSession::keep_best_placements(const cv::Mat& bgr, std::size_t first_placed,
+                                           std::vector<Pose>& hypotheses) const {
+  const auto keep = static_cast<std::size_t>(params_.color_search_refined);
+  if (keep == 0 || hypotheses.size() - first_placed <= keep) return;
+  const std::vector<Pose> placed(hypotheses.begin() + static_cast<std::ptrdiff_t>(first_placed),
+                                 hypotheses.end());
+  const std::vector<SearchCandidate> scored = search_->score(bgr, placed, tracker_->camera());
+  std::vector<std::size_t> order(placed.size());
+  std::iota(order.begin(), order.end(), 0);
+  // Best contrast first; a tie keeps the search's order.
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return scored[a].contrast > scored[b].contrast;
+  });
+  order.resize(keep);
+  std::sort(order.begin(), order.end());  // the kept ones in the search's order
+  hypotheses.resize(first_placed);
+  for (const std::size_t i : order) hypotheses.push_back(placed[i]);
 }
 
 Pose TrackingSession::search_reference() const {

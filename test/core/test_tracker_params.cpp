@@ -163,6 +163,11 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   bad.color_learn_interval_frames = 0;
   EXPECT_THROW(bad.validate(), std::invalid_argument);
   bad = realtime;
+  bad.color_search_refined = -1;  // 0 = all
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  EXPECT_EQ(realtime.color_search_refined, 8);
+  EXPECT_EQ(TrackerParams{}.color_search_refined, 0);
+  bad = realtime;
   bad.relocalization_override_inliers = 3;  // fewer than PnP + a check need
   EXPECT_THROW(bad.validate(), std::invalid_argument);
   // The feature relocalizer is realtime's, and only while lost (it costs nothing while

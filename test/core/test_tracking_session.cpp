@@ -464,6 +464,45 @@ TEST(TrackingSession, RecordedHypothesesAreWhatTheSearchChoseFrom) {
   EXPECT_GT(on_the_box, 0) << "no recorded hypothesis on the box that came back";
 }
 
+/// color_search_refined: the red box is hidden until lost and shown again 12 cm away. With all
+/// placements and turns refined a search holds up to 2 + 3 x 7 hypotheses; with 3 kept, at most
+/// 2 + 3 (a frame may hold two searches), and the box is still found again within 10 frames.
+TEST(TrackingSession, ColourSearchRefinesOnlyTheBestPlacements) {
+  const ColourScene scene;
+  const Pose away = test::move(scene.start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
+  TrackerParams params = quick_realtime();
+  params.feature_relocalization = false;
+  ASSERT_EQ(params.color_search_placements, 3);
+  ASSERT_GT(params.color_search_rotation_deg, 0.0);
+  for (const int refined : {0, 3}) {
+    SCOPED_TRACE("color_search_refined " + std::to_string(refined));
+    params.color_search_refined = refined;
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.set_record_hypotheses(true);
+    session.initialize(scene.start);
+    double stamp = 0.0;
+    for (int i = 0; i < 8; ++i, stamp += 0.033)
+      session.track({test::render_frame(scene.renderer, scene.camera, scene.start, scene.background, 1.5, i), stamp});
+    for (int i = 0; i < 12; ++i, stamp += 0.033) session.track({scene.background.clone(), stamp});
+    ASSERT_EQ(session.state(), TrackState::kLost);
+    std::size_t most = 0;
+    bool back = false;
+    for (int i = 0; i < 10 && !back; ++i, stamp += 0.033) {
+      const SessionResult r = session.track(
+          {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 50 + i), stamp});
+      most = std::max(most, r.hypotheses.size());
+      back = r.state == TrackState::kTracking && translation_error(r.frame.object_to_camera, away) < 0.01 &&
+             rotation_error_deg(r.frame.object_to_camera, away) < 3.0;
+    }
+    EXPECT_TRUE(back) << "not re-acquired within 10 frames";
+    if (refined == 0)
+      EXPECT_GT(most, 2u * (3 + 2)) << "the search refined no more than it would keep: the test shows nothing";
+    else
+      EXPECT_LE(most, 2u * (3 + 2));
+  }
+}
+
 /// color_search_reach_diameters: the red box is hidden until the session declares it lost, then
 /// comes back 2 cm from where it was, its middle covered by a bar, while a whole twin stands 17 cm
 /// away on the other side (the better colour match). Searching the whole frame takes the twin;

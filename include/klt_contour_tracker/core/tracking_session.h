@@ -260,6 +260,10 @@ class TrackingSession {
   /// The colour search's reference pose: the last good pose, its centre moved along its viewing
   /// ray into the trusted depth range (trusted_depth_ratio; unchanged when off).
   Pose search_reference() const;
+  /// color_search_refined: of hypotheses[first_placed..] (the colour placements and their
+  /// turns), keeps the color_search_refined with the best colour contrast in `bgr`, in order.
+  void keep_best_placements(const cv::Mat& bgr, std::size_t first_placed,
+                            std::vector<Pose>& hypotheses) const;
   /// Depth (m, along the camera axis) of the object's centre at `object_to_camera`.
   double center_depth_m(const Pose& object_to_camera) const;
   /// trusted_depth_ratio: `object_to_camera`'s centre lies outside the trusted depth range.
