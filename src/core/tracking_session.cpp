@@ -146,6 +146,7 @@ void TrackingSession::initialize(const Pose& object_to_camera) {
   unconfirmed_.reset();
   rotation_check_winner_ = -1;
   frames_since_doubt_ = 1000;
+  reacquiring_frames_ = 0;
   trusted_depth_m_ = center_depth_m(object_to_camera);
   frames_since_recovery_ = kTrustAfterFrames;
 }
@@ -440,6 +441,7 @@ double TrackingSession::search_reach_px() const {
 
 bool TrackingSession::relocalize(const Frame& frame, const cv::Mat& gray, SessionResult& result) {
   if (relocalizer_->keyframes() == 0) return false;
+  if ((reacquiring_frames_ - 1) % params_.relocalization_interval_frames != 0) return false;
   // As the colour search's hypotheses: not farther than the object could have gone
   // (color_search_reach_diameters; a clutter thing wearing the object's texture matches too).
   // The features are detected only where it can be: the object's rectangle at the last good
@@ -790,6 +792,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   initialized_since_last_frame_ = false;
 
   result.reacquiring = monitor_.should_reacquire();
+  reacquiring_frames_ = result.reacquiring ? reacquiring_frames_ + 1 : 0;
   if (!result.reacquiring) unconfirmed_.reset();
   frame_search_ = FrameSearch();
   frame_hypotheses_.clear();

@@ -168,6 +168,11 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   EXPECT_EQ(realtime.color_search_refined, 8);
   EXPECT_EQ(TrackerParams{}.color_search_refined, 0);
   bad = realtime;
+  bad.relocalization_interval_frames = 0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  EXPECT_EQ(realtime.relocalization_interval_frames, 2);
+  EXPECT_EQ(TrackerParams{}.relocalization_interval_frames, 1);
+  bad = realtime;
   bad.relocalization_override_inliers = 3;  // fewer than PnP + a check need
   EXPECT_THROW(bad.validate(), std::invalid_argument);
   // The feature relocalizer is realtime's, and only while lost (it costs nothing while

@@ -731,6 +731,48 @@ TEST(TrackingSession, FeatureRelocalizationReacquiresATexturedObjectFarAway) {
   }
 }
 
+/// relocalization_interval_frames: the textured box of the test above, hidden until lost and
+/// shown again far away, is relocalized by its features only on the first lost frame and every
+/// interval-th after it: found within 10 frames at intervals 1 and 2, never at 1000 (the first
+/// lost frame showed nothing).
+TEST(TrackingSession, FeaturesAreMatchedOnEveryIntervalthLostFrame) {
+  const Scene scene;
+  const Pose start = test::make_pose(0.45);
+  const Pose away = test::move(start, 8.0, {0.2, 1.0, 0.3}, {0.12, 0.04, 0.0});
+  TrackerParams params = quick_realtime();
+  params.color_search = false;  // the features alone
+  params.feature_relocalization = true;
+  params.relocalization_while_tracking = false;
+  for (const int interval : {1, 2, 1000}) {
+    SCOPED_TRACE("relocalization_interval_frames " + std::to_string(interval));
+    params.relocalization_interval_frames = interval;
+    TrackingSession session(scene.mesh, params);
+    session.set_camera(scene.camera);
+    session.initialize(start);
+    double stamp = 0.0;
+    for (int i = 0; i < 6; ++i, stamp += 0.033)
+      session.track({test::render_frame(scene.renderer, scene.camera, start, scene.background, 1.5, i), stamp});
+    int reacquiring = 0;  // frames in a row that re-acquired, as the session counts them
+    const auto counted = [&](const SessionResult& r) {
+      reacquiring = r.reacquiring ? reacquiring + 1 : 0;
+      if (r.relocalized) EXPECT_EQ((reacquiring - 1) % interval, 0) << "relocalized off the interval";
+    };
+    for (int i = 0; i < 12; ++i, stamp += 0.033) counted(session.track({scene.hidden(i), stamp}));
+    ASSERT_EQ(session.state(), TrackState::kLost);
+    bool back = false, relocalized = false;
+    for (int i = 0; i < 10 && !back; ++i, stamp += 0.033) {
+      const SessionResult r = session.track(
+          {test::render_frame(scene.renderer, scene.camera, away, scene.background, 1.5, 50 + i), stamp});
+      counted(r);
+      relocalized = relocalized || r.relocalized;
+      back = r.state == TrackState::kTracking && translation_error(r.frame.object_to_camera, away) < 0.005 &&
+             rotation_error_deg(r.frame.object_to_camera, away) < 2.0;
+    }
+    EXPECT_EQ(back, interval < 1000);
+    EXPECT_EQ(relocalized, interval < 1000);
+  }
+}
+
 /// color_confirm_ratio: the object comes back far away with its colours washed out (as under
 /// blur or a partial occlusion), so that the best placement's contrast stays below
 /// color_accept_ratio x the learned level. Without confirmation the session never

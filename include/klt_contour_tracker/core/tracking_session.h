@@ -253,6 +253,7 @@ class TrackingSession {
   /// texture_shift_search_below: the shift found on the last frame it searched, if any.
   std::optional<Eigen::Vector3d> texture_shift_winner_m_;
   int frames_since_doubt_ = 1000;  ///< frames since KLT last failed or a re-acquisition
+  int reacquiring_frames_ = 0;     ///< frames in a row that re-acquired (relocalization_interval_frames)
   /// trusted_depth_ratio: depth (m) of the object's centre at the last trusted pose, and the
   /// good TRACKING frames since the last re-acquisition (trusted from kTrustAfterFrames on).
   double trusted_depth_m_ = 0.0;
