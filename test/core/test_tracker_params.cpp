@@ -128,7 +128,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 108u);
+  EXPECT_EQ(fields.size(), 110u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
