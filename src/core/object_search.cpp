@@ -270,28 +270,37 @@ cv::Mat silhouette_ring(const cv::Mat& mask, int ring_px) {
   return dilated & ~mask;
 }
 
-cv::Mat ObjectSearch::contrast_map(const cv::Mat& posterior, const PinholeCamera& working_camera,
-                                   const Pose& reference, double depth_m, const cv::Rect& centres,
-                                   cv::Mat& visible) const {
-  visible.release();
-  // The silhouette on a square canvas with the object's centre at the canvas centre.
+ObjectSearch::SilhouetteTemplate ObjectSearch::silhouette_template(
+    const PinholeCamera& working_camera, const cv::Size& image_size, const Pose& reference,
+    double depth_m) const {
+  SilhouetteTemplate t;
   const double radius_px = working_camera.fx() * 0.5 * diameter_m_ / depth_m;
   const int ring_guess =
       std::max(2, static_cast<int>(std::ceil(settings_.ring_fraction * 2.0 * radius_px)));
   const int half = static_cast<int>(std::ceil(radius_px)) + ring_guess + 2;
   const int side = 2 * half + 1;
-  if (side > 4 * std::max(posterior.cols, posterior.rows) || side < 5) return cv::Mat();
+  if (side > 4 * std::max(image_size.width, image_size.height) || side < 5) return t;
   const PinholeCamera canvas_camera(working_camera.fx(), working_camera.fy(), half, half, side,
                                     side);
   const Pose centred =
       placed_at(reference, center_object_, canvas_camera, Eigen::Vector2d(half, half), depth_m);
   const cv::Mat mask = renderer_.render_silhouette(centred, canvas_camera);
   const double area = cv::countNonZero(mask);
-  if (area < 4) return cv::Mat();
+  if (area < 4) return t;
   const cv::Mat ring = silhouette_ring(mask, ring_width_px(mask, settings_.ring_fraction));
-  cv::Mat inside_template, ring_template;
-  mask.convertTo(inside_template, CV_32F, 1.0 / 255.0);
-  ring.convertTo(ring_template, CV_32F, 1.0 / 255.0);
+  mask.convertTo(t.inside, CV_32F, 1.0 / 255.0);
+  ring.convertTo(t.ring, CV_32F, 1.0 / 255.0);
+  cv::integral(mask / 255, t.inside_integral, CV_32S);
+  cv::integral(ring / 255, t.ring_integral, CV_32S);
+  t.half = half;
+  t.side = side;
+  t.area = area;
+  return t;
+}
+
+cv::Mat ObjectSearch::contrast_map(const cv::Mat& posterior, const SilhouetteTemplate& silhouette,
+                                   const cv::Rect& centres, cv::Mat& visible) const {
+  const int half = silhouette.half, side = silhouette.side;
   // Placements reaching outside the image: the posterior padded with zeros, so sums count
   // only pixels inside it. The areas inside the image are the templates' sums over their
   // overlap with the image rectangle: read from integral images, not correlated.
@@ -305,11 +314,8 @@ cv::Mat ObjectSearch::contrast_map(const cv::Mat& posterior, const PinholeCamera
                      needed.br().y - inside.br().y, inside.x - needed.x,
                      needed.br().x - inside.br().x, cv::BORDER_CONSTANT, 0);
   cv::Mat posterior_inside, posterior_ring;  // index (c, r): centre centres.tl() + (c, r)
-  cv::matchTemplate(window, inside_template, posterior_inside, cv::TM_CCORR);
-  cv::matchTemplate(window, ring_template, posterior_ring, cv::TM_CCORR);
-  cv::Mat inside_integral, ring_integral;
-  cv::integral(mask / 255, inside_integral, CV_32S);
-  cv::integral(ring / 255, ring_integral, CV_32S);
+  cv::matchTemplate(window, silhouette.inside, posterior_inside, cv::TM_CCORR);
+  cv::matchTemplate(window, silhouette.ring, posterior_ring, cv::TM_CCORR);
   // Template pixels of the placement centred on image pixel (c, r) that fall in the image.
   auto in_image = [&](const cv::Mat& integral, int r, int c) {
     const int j0 = std::max(0, half - r), j1 = std::min(side, half - r + posterior.rows);
@@ -318,6 +324,7 @@ cv::Mat ObjectSearch::contrast_map(const cv::Mat& posterior, const PinholeCamera
     return static_cast<float>(integral.at<int>(j1, i1) - integral.at<int>(j0, i1) -
                               integral.at<int>(j1, i0) + integral.at<int>(j0, i0));
   };
+  const double area = silhouette.area;
   const float min_area = static_cast<float>(settings_.min_visible_fraction * area);
   cv::Mat contrast(posterior_inside.size(), CV_32F, cv::Scalar(kNotScored));
   visible = cv::Mat(posterior_inside.size(), CV_32F, cv::Scalar(0.0f));
@@ -328,8 +335,8 @@ cv::Mat ObjectSearch::contrast_map(const cv::Mat& posterior, const PinholeCamera
     float* shown = visible.ptr<float>(r);
     for (int c = 0; c < contrast.cols; ++c) {
       const int u = centres.x + c, v = centres.y + r;  // image pixel
-      const float area_inside = in_image(inside_integral, v, u);
-      const float area_ring = in_image(ring_integral, v, u);
+      const float area_inside = in_image(silhouette.inside_integral, v, u);
+      const float area_ring = in_image(silhouette.ring_integral, v, u);
       shown[c] = static_cast<float>(std::min(1.0, area_inside / area));
       if (area_inside < min_area || area_ring < 1.0f) continue;
       out[c] = pi[c] / area_inside - pr[c] / area_ring;
@@ -420,25 +427,36 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
   // One candidate per depth, each depth on its own (the order kept: a tie sorts the same way
   // whatever the thread count).
   std::vector<std::optional<SearchCandidate>> per_depth(settings_.depth_scales.size());
+  // The centres searched (the same at every depth), at the working and the coarse size.
+  const cv::Rect centres = centres_within(small, reference_px, reach_working);
+  if (centres.empty()) return candidates;
+  Eigen::Vector2d coarse_reference = Eigen::Vector2d::Zero();
+  double coarse_reach = 0.0;
+  cv::Rect coarse_centres;
+  if (coarse) {
+    coarse_reference = coarse_camera.project(reference * center_object_);
+    coarse_reach = reach_working * coarse_camera.fx() / working_camera.fx();
+    coarse_centres = centres_within(coarse_posterior, coarse_reference, coarse_reach);
+  }
   workers_->parallel_for(static_cast<int>(per_depth.size()), [&](int d) {
     const double depth_m = reference_depth * settings_.depth_scales[static_cast<std::size_t>(d)];
     const double radius_px = working_camera.fx() * 0.5 * diameter_m_ / depth_m;
-    const cv::Rect centres = centres_within(small, reference_px, reach_working);
-    if (centres.empty()) return;
+    const SilhouetteTemplate silhouette =
+        silhouette_template(working_camera, small.size(), reference, depth_m);
+    if (silhouette.empty()) return;
     std::vector<Peak> found;
     cv::Mat visible;
     // Coarse to fine when the area searched is large and the object large enough to show at
     // half size: the coarse map's best peaks, each searched again at the working size within
     // kFineReachPx (the coarse pixel's footprint and a pixel of slack).
     if (coarse && centres.area() > kCoarseMinCentres && radius_px >= kCoarseMinRadiusPx) {
-      const Eigen::Vector2d coarse_reference = coarse_camera.project(reference * center_object_);
-      const double coarse_reach = reach_working * coarse_camera.fx() / working_camera.fx();
-      const cv::Rect coarse_centres = centres_within(coarse_posterior, coarse_reference, coarse_reach);
       if (coarse_centres.empty()) return;
+      const SilhouetteTemplate coarse_silhouette =
+          silhouette_template(coarse_camera, coarse_posterior.size(), reference, depth_m);
+      if (coarse_silhouette.empty()) return;
       cv::Mat coarse_visible;
-      const cv::Mat coarse_map = contrast_map(coarse_posterior, coarse_camera, reference, depth_m,
-                                              coarse_centres, coarse_visible);
-      if (coarse_map.empty()) return;
+      const cv::Mat coarse_map =
+          contrast_map(coarse_posterior, coarse_silhouette, coarse_centres, coarse_visible);
       const int suppress = std::max(2, static_cast<int>(0.25 * radius_px * coarse_camera.fx() /
                                                         working_camera.fx()));
       for (const Peak& p : peaks(coarse_map, coarse_visible, coarse_centres, coarse_reference, coarse_reach,
@@ -447,15 +465,12 @@ std::vector<SearchCandidate> ObjectSearch::search(const cv::Mat& bgr, const Pose
         const cv::Rect fine_centres =
             centres_within(small, fine_px, kFineReachPx) & centres;
         if (fine_centres.empty()) continue;
-        const cv::Mat fine_map =
-            contrast_map(posterior, working_camera, reference, depth_m, fine_centres, visible);
-        if (fine_map.empty()) continue;
+        const cv::Mat fine_map = contrast_map(posterior, silhouette, fine_centres, visible);
         for (const Peak& q : peaks(fine_map, visible, fine_centres, reference_px, reach_working, 1, 0))
           found.push_back(q);
       }
     } else {
-      const cv::Mat map = contrast_map(posterior, working_camera, reference, depth_m, centres, visible);
-      if (map.empty()) return;
+      const cv::Mat map = contrast_map(posterior, silhouette, centres, visible);
       found = peaks(map, visible, centres, reference_px, reach_working, 1, 0);
     }
     if (found.empty()) return;

@@ -114,14 +114,24 @@ class ObjectSearch {
   /// bounding box with room for the ring, within one image size around the image.
   cv::Rect silhouette_canvas(const Pose& object_to_camera,
                              const PinholeCamera& working_camera) const;
-  /// The contrast of the silhouette of `reference`'s rotation at `depth_m`, centred on each
-  /// pixel of `centres` of `posterior` (seen by `working_camera`): CV_32F, indexed from
-  /// centres.tl(), kNotScored where less than min_visible_fraction of it or none of its ring is in
-  /// the image; `visible` gets the share of the silhouette in the image. Empty when the
-  /// silhouette is too small or too large to correlate.
-  cv::Mat contrast_map(const cv::Mat& posterior, const PinholeCamera& working_camera,
-                       const Pose& reference, double depth_m, const cv::Rect& centres,
-                       cv::Mat& visible) const;
+  /// The silhouette of one rotation and depth as the search correlates it: rendered on a square
+  /// canvas (side = 2 half + 1 px) with the object's centre at the canvas centre, its ring, both
+  /// as CV_32F 0/1 templates, and their integral images (for the parts inside the image).
+  struct SilhouetteTemplate {
+    int half = 0, side = 0;
+    double area = 0.0;  ///< silhouette pixels
+    cv::Mat inside, ring, inside_integral, ring_integral;
+    bool empty() const { return area <= 0.0; }
+  };
+  /// The silhouette of `reference`'s rotation at `depth_m` seen by `working_camera` (whose image
+  /// is `image_size`); empty when too small or too large to correlate.
+  SilhouetteTemplate silhouette_template(const PinholeCamera& working_camera, const cv::Size& image_size,
+                                         const Pose& reference, double depth_m) const;
+  /// The contrast of `silhouette` centred on each pixel of `centres` of `posterior`: CV_32F,
+  /// indexed from centres.tl(), kNotScored where less than min_visible_fraction of it or none of
+  /// its ring is in the image; `visible` gets the share of the silhouette in the image.
+  cv::Mat contrast_map(const cv::Mat& posterior, const SilhouetteTemplate& silhouette,
+                       const cv::Rect& centres, cv::Mat& visible) const;
   /// Per-pixel P(foreground | colour) of a working-size image, CV_32F.
   cv::Mat posterior_map(const cv::Mat& working_bgr) const;
 
