@@ -36,17 +36,15 @@ DEV = os.path.join(DATA, "dev")
 def generate(a):
     for o in B.HARD_OBJECTS:
         B.ensure_model(DATA, B.HARD_OBJECTS[o]["model"])
-    if a.long:  # the long section's sequences (their draws are made by run, as links)
-        keys = [(o, c) for o in B.HARD_OBJECTS for c in B.LONG_CONDITIONS]
+    # The long section's sequences (their draws are made by run, as links) or the slow section's
+    # (precision; run --mismatch tracks them with the mesh off).
+    variant = (("long", B.LONG_CONDITIONS, B.LONG_FRAMES) if a.long else
+               ("slow", B.SLOW_CONDITIONS, B.HARD_FRAMES) if a.slow else None)
+    if variant:
+        name, conditions, frames = variant
+        keys = [(o, c) for o in B.HARD_OBJECTS for c in conditions]
         with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as ex:
-            list(ex.map(lambda k: B.variant_sequence(DATA, "long", B.LONG_CONDITIONS, k[0], k[1], B.LONG_FRAMES),
-                        keys))
-        return
-    if a.slow:  # the slow section's sequences (precision; --mismatch tracks them with the mesh off)
-        keys = [(o, c) for o in B.HARD_OBJECTS for c in B.SLOW_CONDITIONS]
-        with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as ex:
-            list(ex.map(lambda k: B.variant_sequence(DATA, "slow", B.SLOW_CONDITIONS, k[0], k[1], B.HARD_FRAMES),
-                        keys))
+            list(ex.map(lambda k: B.variant_sequence(DATA, name, conditions, k[0], k[1], frames), keys))
         return
 
     def one(key):

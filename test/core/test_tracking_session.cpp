@@ -496,10 +496,11 @@ TEST(TrackingSession, ColourSearchRefinesOnlyTheBestPlacements) {
              rotation_error_deg(r.frame.object_to_camera, away) < 3.0;
     }
     EXPECT_TRUE(back) << "not re-acquired within 10 frames";
-    if (refined == 0)
+    if (refined == 0) {
       EXPECT_GT(most, 2u * (3 + 2)) << "the search refined no more than it would keep: the test shows nothing";
-    else
+    } else {
       EXPECT_LE(most, 2u * (3 + 2));
+    }
   }
 }
 
