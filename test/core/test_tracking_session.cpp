@@ -756,7 +756,9 @@ TEST(TrackingSession, FeaturesAreMatchedOnEveryIntervalthLostFrame) {
     int reacquiring = 0;  // frames in a row that re-acquired, as the session counts them
     const auto counted = [&](const SessionResult& r) {
       reacquiring = r.reacquiring ? reacquiring + 1 : 0;
-      if (r.relocalized) EXPECT_EQ((reacquiring - 1) % interval, 0) << "relocalized off the interval";
+      if (r.relocalized) {
+        EXPECT_EQ((reacquiring - 1) % interval, 0) << "relocalized off the interval";
+      }
     };
     for (int i = 0; i < 12; ++i, stamp += 0.033) counted(session.track({scene.hidden(i), stamp}));
     ASSERT_EQ(session.state(), TrackState::kLost);
