@@ -142,9 +142,10 @@ TEST(TrackingSession, AFindRepeatedWhileLostRecoversTheTrack) {
   quality.min_quality = 1.0;
   quality.energy_weight = 0.5;
   quality.recover_after_good_frames = 1;
-  for (const double repeat : {0.0, 0.05}) {
+  for (const double repeat : {0.0, make_preset("realtime").repeat_recover_diameters}) {
     TrackerParams params = quick_paper();
     params.repeat_recover_diameters = repeat;
+    params.repeat_recover_deg = make_preset("realtime").repeat_recover_deg;
     TrackingSession session(scene.mesh, params, quality);
     session.set_camera(scene.camera);
     session.initialize(scene.pose(0));
