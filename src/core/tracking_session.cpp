@@ -279,6 +279,11 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
         record.in_reach = candidate(i);
         record.chosen = i == best_index;
         record.reacquiring = monitor_.should_reacquire();
+        if (texture_ && texture_->ready() && texture_->has_color_pattern()) {
+          const TextureAgreement a = texture_->agreement(texture_->prepare(bgr, refined_poses[i], camera),
+                                                         refined_poses[i], camera);
+          if (a.points >= SurfaceTexture::kMinPoints) record.surface_correlation = a.correlation;
+        }
         frame_hypotheses_.push_back(record);
       }
     TrackResult best = refined[best_index];
@@ -658,9 +663,12 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   const auto kept_place = [&](const Pose& p) {
     return (p * center - held_center).norm() < kRotationCheckMaxShiftDiameters * tracker_->diameter_m();
   };
+  const double refined_correlation =
+      refined.refined ? texture_->agreement(prepared, refined.object_to_camera, camera).correlation
+                      : std::numeric_limits<double>::quiet_NaN();
   const bool refined_better =
       refined.refined &&
-      texture_->agreement(prepared, refined.object_to_camera, camera).correlation >=
+      refined_correlation >=
           std::max(held_correlation + params_.texture_check_margin, kTextureCheckMinCorrelation) &&
       refined.energy_after >= kTextureCheckMinEnergyRatio * held.energy_after &&
       kept_place(refined.object_to_camera) &&
@@ -678,6 +686,7 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   result.frame = chosen;
   result.color = evidence_of(colors[refined_better ? 1 : 2]);
   result.texture_corrected = true;
+  result.texture_correlation = refined_better ? refined_correlation : best_correlation;
 }
 
 bool TrackingSession::align_by_texture(const Frame& frame, const cv::Mat& bgr,

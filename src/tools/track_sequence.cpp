@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
       if (!hypotheses) throw std::runtime_error(options.hypotheses + ": cannot write");
       hypotheses << "frame,reacquiring,index,contrast,energy,in_reach,chosen,error_diameters,"
                     "centre_diameters,rotation_deg,start_error_diameters,start_centre_diameters,"
-                    "start_rotation_deg\n";
+                    "start_rotation_deg,surface_correlation\n";
     }
     const double score_diameter_m = score_mesh->diameter();
     // A pose against a true one: error delta_i and centre distance (object diameters, against
@@ -254,7 +254,8 @@ int main(int argc, char** argv) {
           hypotheses << i << ',' << (h.reacquiring ? 1 : 0) << ',' << k << ','
                      << cv::format("%.4f,%.4g,%d,%d,", h.contrast, h.energy, h.in_reach ? 1 : 0,
                                    h.chosen ? 1 : 0)
-                     << errors(h.object_to_camera) << ',' << errors(h.start_object_to_camera) << '\n';
+                     << errors(h.object_to_camera) << ',' << errors(h.start_object_to_camera) << ','
+                     << cv::format("%.3f", h.surface_correlation) << '\n';
         }
       }
       if (i > 0 && result.frame.status != kct::TrackStatus::kInvalidInput)

@@ -35,6 +35,9 @@ struct HypothesisRecord {
   /// A search of a frame that re-acquires (SessionResult::reacquiring), not a check of a
   /// tracked pose (extrapolated_search_ratio / tracked_search_ratio).
   bool reacquiring = false;
+  /// Its surface colours' correlation with the learned ones (SurfaceTexture::agreement; objects
+  /// with a colour pattern): NaN when not scored (no pattern, fewer than kMinPoints points).
+  double surface_correlation = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// What one TrackingSession::track() call did.
@@ -59,8 +62,9 @@ struct SessionResult {
   /// colours match the learned ones better.
   bool texture_corrected = false;
   /// texture_check's correlation of the held pose's surface colours with the learned ones
-  /// (SurfaceTexture::agreement), in [-1, 1]; NaN when the check did not run on this frame or
-  /// fewer than SurfaceTexture::kMinPoints learned points face the camera there.
+  /// (SurfaceTexture::agreement), in [-1, 1], or the corrected pose's when the check replaced
+  /// it; NaN when the check did not run on this frame or fewer than SurfaceTexture::kMinPoints
+  /// learned points face the camera there.
   double texture_correlation = std::numeric_limits<double>::quiet_NaN();
   ColorEvidence color;       ///< colour evidence of the pose (valid with color_search)
   /// With set_record_hypotheses(true): every hypothesis the colour searches of this frame
