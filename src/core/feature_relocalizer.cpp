@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -19,6 +20,7 @@ constexpr const char* kOwner = "FeatureRelocalizerSettings";
 
 void FeatureRelocalizerSettings::validate() const {
   check_range(kOwner, "max_features", max_features, 20, 100000);
+  check_range(kOwner, "frame_features", frame_features, 20, 100000);
   check_range(kOwner, "fast_threshold", fast_threshold, 1, 255);
   check_range(kOwner, "max_keyframes", max_keyframes, 1, 1000);
   check_range(kOwner, "keyframe_min_angle_deg", keyframe_min_angle_deg, 0.0, 180.0);
@@ -37,6 +39,8 @@ FeatureRelocalizer::FeatureRelocalizer(std::shared_ptr<const Mesh> mesh,
   settings_.validate();
   orb_ = cv::ORB::create(settings_.max_features, 1.2f, 8, 15, 0, 2, cv::ORB::HARRIS_SCORE, 15,
                          settings_.fast_threshold);
+  frame_orb_ = cv::ORB::create(settings_.frame_features, 1.2f, 8, 15, 0, 2, cv::ORB::HARRIS_SCORE, 15,
+                               settings_.fast_threshold);
   center_object_ = mesh_->bounding_box_center();
   const Eigen::AlignedBox3d box = mesh_->bounding_box();
   for (int i = 0; i < 8; ++i)
@@ -125,7 +129,7 @@ Relocalization FeatureRelocalizer::locate(const cv::Mat& gray, const PinholeCame
   if (roi.width < kMinRegionPx || roi.height < kMinRegionPx) return result;
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
-  orb_->detectAndCompute(gray(roi), cv::noArray(), keypoints, descriptors);
+  frame_orb_->detectAndCompute(gray(roi), cv::noArray(), keypoints, descriptors);
   if (static_cast<int>(keypoints.size()) < settings_.min_inliers) return result;
 
   // Ratio test per keyframe (a point seen by two keyframes would fail it across them); each
@@ -146,23 +150,42 @@ Relocalization FeatureRelocalizer::locate(const cv::Mat& gray, const PinholeCame
       }
     }
   }
+  // Best matches first: PROSAC draws its samples from the top of this order.
+  std::vector<std::size_t> order(keypoints.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return best_distance[a] < best_distance[b]; });
   std::vector<cv::Point3f> object_points;
   std::vector<cv::Point2f> image_points;
-  for (std::size_t i = 0; i < keypoints.size(); ++i) {
-    if (best_distance[i] > 1e29f) continue;
+  for (std::size_t i : order) {
+    if (best_distance[i] > 1e29f) break;
     object_points.push_back(best_point[i]);
     image_points.push_back(keypoints[i].pt + cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y)));
   }
   result.matches = static_cast<int>(object_points.size());
   if (result.matches < settings_.min_inliers) return result;
 
+  // OpenCV's USAC rather than the classic solvePnPRansac: with a few hundred matches of which
+  // 10-15 % are right, EPnP-RANSAC found the object 1-5 times in 50 (synthetic) and on 53 of 948
+  // real hard frames; PROSAC + MSAC + local optimization on 200 (31 wrong, which min_inliers
+  // rejects mostly). A fixed generator state keeps runs repeatable.
+  cv::UsacParams usac;
+  usac.maxIterations = settings_.ransac_iterations;
+  usac.threshold = settings_.ransac_reprojection_px;
+  usac.confidence = 0.999;
+  usac.sampler = cv::SAMPLING_PROSAC;
+  usac.score = cv::SCORE_METHOD_MSAC;
+  usac.loMethod = cv::LOCAL_OPTIM_INNER_LO;
+  usac.randomGeneratorState = 1;
   cv::Mat rvec, tvec;
   std::vector<int> inliers;
-  if (!cv::solvePnPRansac(object_points, image_points, camera.K(), cv::noArray(), rvec, tvec, false,
-                          settings_.ransac_iterations,
-                          static_cast<float>(settings_.ransac_reprojection_px), 0.999, inliers,
-                          cv::SOLVEPNP_EPNP))
-    return result;
+  try {
+    if (!cv::solvePnPRansac(object_points, image_points, camera.K(), cv::noArray(), rvec, tvec,
+                            inliers, usac))
+      return result;
+  } catch (const cv::Exception&) {
+    return result;  // degenerate samples (all points on a line): nothing found
+  }
   result.inliers = static_cast<int>(inliers.size());
   if (result.inliers < settings_.min_inliers ||
       result.inliers < settings_.min_inlier_ratio * result.matches)
