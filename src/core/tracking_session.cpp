@@ -266,6 +266,10 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     // A hypothesis the refinement took out of reach is not a candidate (the last good pose,
     // the first, is the fallback).
     const auto candidate = [&](std::size_t i) { return i == 0 || within_reach(refined_poses[i], reach_px); };
+    // The learned surface's agreement with this frame at a pose (texture_ ready).
+    const auto surface_at = [&](const Pose& pose) {
+      return texture_->agreement(texture_->prepare(bgr, pose, camera), pose, camera);
+    };
     std::size_t best_index = 0;
     for (std::size_t i = 1; i < scored.size(); ++i)
       if (scored[i].contrast > scored[best_index].contrast && candidate(i)) best_index = i;
@@ -280,8 +284,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
         record.chosen = i == best_index;
         record.reacquiring = monitor_.should_reacquire();
         if (texture_ && texture_->ready() && texture_->has_color_pattern()) {
-          const TextureAgreement a = texture_->agreement(texture_->prepare(bgr, refined_poses[i], camera),
-                                                         refined_poses[i], camera);
+          const TextureAgreement a = surface_at(refined_poses[i]);
           if (a.points >= SurfaceTexture::kMinPoints) record.surface_correlation = a.correlation;
         }
         frame_hypotheses_.push_back(record);
@@ -303,8 +306,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     if (best_contrast < bar.min_contrast || best.energy_after < bar.min_energy) return TrackResult();
     if (std::isfinite(bar.min_surface_correlation) && texture_ && texture_->ready()) {
       const Pose& pose = best.object_to_camera;
-      const TextureAgreement agreement =
-          texture_->agreement(texture_->prepare(bgr, pose, camera), pose, camera);
+      const TextureAgreement agreement = surface_at(pose);
       // A find that shows too little of the learned surface cannot stand against a held pose
       // whose surface agrees.
       if (agreement.points < SurfaceTexture::kMinPoints ||
