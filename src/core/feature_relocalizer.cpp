@@ -16,6 +16,12 @@ namespace {
 
 constexpr const char* kOwner = "FeatureRelocalizerSettings";
 
+// Keyframes and whole frames use the same ORB settings and differ only in how many
+// features they keep; one place keeps the two detectors in step.
+cv::Ptr<cv::ORB> make_orb(int max_features, int fast_threshold) {
+  return cv::ORB::create(max_features, 1.2f, 8, 15, 0, 2, cv::ORB::HARRIS_SCORE, 15, fast_threshold);
+}
+
 }  // namespace
 
 void FeatureRelocalizerSettings::validate() const {
@@ -37,10 +43,8 @@ FeatureRelocalizer::FeatureRelocalizer(std::shared_ptr<const Mesh> mesh,
     : mesh_(std::move(mesh)), settings_(settings), renderer_(mesh_) {
   if (!mesh_ || mesh_->faces.empty()) throw std::invalid_argument("FeatureRelocalizer: empty mesh");
   settings_.validate();
-  orb_ = cv::ORB::create(settings_.max_features, 1.2f, 8, 15, 0, 2, cv::ORB::HARRIS_SCORE, 15,
-                         settings_.fast_threshold);
-  frame_orb_ = cv::ORB::create(settings_.frame_features, 1.2f, 8, 15, 0, 2, cv::ORB::HARRIS_SCORE, 15,
-                               settings_.fast_threshold);
+  orb_ = make_orb(settings_.max_features, settings_.fast_threshold);
+  frame_orb_ = make_orb(settings_.frame_features, settings_.fast_threshold);
   center_object_ = mesh_->bounding_box_center();
   const Eigen::AlignedBox3d box = mesh_->bounding_box();
   for (int i = 0; i < 8; ++i)
