@@ -54,7 +54,7 @@ const std::vector<std::pair<const char*, Field>>& fields() {
       KCT_FIELD(texture_check_step_deg), KCT_FIELD(texture_check_every_frame),
       KCT_FIELD(plain_surface_keypoint_scale),
       KCT_FIELD(texture_shift_search_below), KCT_FIELD(texture_align_below),
-      KCT_FIELD(surface_hold_correlation),
+      KCT_FIELD(surface_hold_correlation), KCT_FIELD(surface_recover_correlation),
       KCT_FIELD(extrapolated_search_ratio), KCT_FIELD(extrapolated_accept_margin),
       KCT_FIELD(tracked_search_ratio), KCT_FIELD(tracked_search_surface_drop),
       KCT_FIELD(occlusion_mask_radius_px),
@@ -215,6 +215,7 @@ void TrackerParams::validate() const {
   check_range(kOwner, "texture_shift_search_below", texture_shift_search_below, 0.0, 1.0);
   check_range(kOwner, "texture_align_below", texture_align_below, 0.0, 1.0);
   check_range(kOwner, "surface_hold_correlation", surface_hold_correlation, 0.0, 1.0);
+  check_range(kOwner, "surface_recover_correlation", surface_recover_correlation, 0.0, 1.0);
   check_range(kOwner, "extrapolated_search_ratio", extrapolated_search_ratio, 0.0, 2.0);
   check_range(kOwner, "tracked_search_ratio", tracked_search_ratio, 0.0, 2.0);
   check_range(kOwner, "tracked_search_surface_drop", tracked_search_surface_drop, 0.0, 2.0);

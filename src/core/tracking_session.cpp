@@ -855,6 +855,7 @@ SessionResult TrackingSession::track(const Frame& frame) {
   rule.recover_ratio = params_.color_recover_ratio;
   rule.recover_min_visible = params_.color_recover_min_visible;
   rule.surface_hold_correlation = params_.surface_hold_correlation;
+  rule.recover_min_surface_correlation = params_.surface_recover_correlation;
   rule.extrapolated_good_frames = params_.extrapolated_good_frames;
   rule.outside_trusted_depth = result.has_pose() && result.frame.status != TrackStatus::kInitialized &&
                                outside_trusted_depth(result.frame.object_to_camera);

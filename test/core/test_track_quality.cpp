@@ -322,6 +322,62 @@ TEST(TrackQuality, ASurfaceThatStillMatchesHoldsABadTrackedFrame) {
   EXPECT_EQ(off.update(blurred, matching, none), TrackState::kLost);
 }
 
+/// recover_min_surface_correlation: while lost, a tracked frame whose surface colours do not
+/// match (a static patch of the background the keypoints hold) does not count towards the
+/// recovery, however good its energy and keypoints; an unscored surface, a re-acquisition's find
+/// and a frame while tracking are not held back.
+TEST(TrackQuality, ASurfaceThatDoesNotMatchKeepsTheTrackLost) {
+  TrackQualityParams params;
+  params.lost_after_bad_frames = 2;
+  params.recover_after_good_frames = 2;
+  params.energy_level_smoothing = 1.0;  // level = the last good energy
+  ColorLossRule rule;
+  rule.recover_min_surface_correlation = 0.3;
+  ColorEvidence matching, differing, unscored;
+  matching.surface_correlation = 0.8;
+  differing.surface_correlation = 0.29;
+  const TrackResult good = refined_result(10.0, true, 1.0);
+  const TrackResult bad = refined_result(1.0, false, 0.0);
+  TrackResult found = good;
+  found.status = TrackStatus::kReacquired;
+
+  const auto lost_monitor = [&]() {
+    TrackQualityMonitor m(params);
+    m.on_initialized(Pose::Identity());
+    m.update(good, matching, rule);
+    m.update(bad, matching, rule);
+    EXPECT_EQ(m.update(bad, matching, rule), TrackState::kLost);
+    return m;
+  };
+  // While tracking, a differing surface does not make a good frame bad.
+  TrackQualityMonitor tracking(params);
+  tracking.on_initialized(Pose::Identity());
+  EXPECT_EQ(tracking.update(good, differing, rule), TrackState::kTracking);
+  EXPECT_TRUE(tracking.last_good());
+
+  // Lost: good tracked frames on a differing surface stay bad and keep the re-acquisition on.
+  TrackQualityMonitor held_back = lost_monitor();
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(held_back.update(good, differing, rule), TrackState::kLost);
+    EXPECT_FALSE(held_back.last_good());
+    EXPECT_TRUE(held_back.should_reacquire());
+  }
+  // The same frames on the matching surface, or unscored, recover it after 2.
+  EXPECT_EQ(held_back.update(good, matching, rule), TrackState::kLost);
+  EXPECT_EQ(held_back.update(good, unscored, rule), TrackState::kTracking);
+  // A re-acquisition's find is not held back by the surface.
+  TrackQualityMonitor finds = lost_monitor();
+  EXPECT_EQ(finds.update(found, differing, rule), TrackState::kLost);
+  EXPECT_TRUE(finds.last_good());
+  EXPECT_EQ(finds.update(found, differing, rule), TrackState::kTracking);
+
+  // Off (0): the differing surface recovers after 2.
+  ColorLossRule off;
+  TrackQualityMonitor unchecked = lost_monitor();
+  EXPECT_EQ(unchecked.update(good, differing, off), TrackState::kLost);
+  EXPECT_EQ(unchecked.update(good, differing, off), TrackState::kTracking);
+}
+
 /// extrapolated_good_frames: the first N frames in a row that KLT failed on can be good, later
 /// ones are bad until KLT tracks again; -1 (off) leaves them to their score.
 TEST(TrackQuality, OnlyTheFirstExtrapolatedFramesInARowCanBeGood) {

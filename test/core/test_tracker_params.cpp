@@ -46,6 +46,7 @@ TEST(TrackerParams, PaperPresetHasNoCuesBeyondThePaper) {
   EXPECT_DOUBLE_EQ(p.texture_shift_search_below, 0.0);
   EXPECT_DOUBLE_EQ(p.texture_align_below, 0.0);
   EXPECT_DOUBLE_EQ(p.surface_hold_correlation, 0.0);
+  EXPECT_DOUBLE_EQ(p.surface_recover_correlation, 0.0);
   EXPECT_EQ(p.extrapolated_good_frames, -1);
   EXPECT_DOUBLE_EQ(p.trusted_depth_ratio, 0.0);
 }
@@ -128,7 +129,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 110u);
+  EXPECT_EQ(fields.size(), 111u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

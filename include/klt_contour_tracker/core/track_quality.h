@@ -65,6 +65,9 @@ struct ColorLossRule {
   /// surface_correlation is at least this is held: neither counted towards the loss nor good
   /// (blur lowers the contour energy and the keypoints while the printed surface still matches).
   double surface_hold_correlation = 0.0;
+  /// 0 = off. While LOST, a frame whose surface_correlation (when scored) is below this does not
+  /// count towards recovery: the surface's own pattern is not where the pose puts it.
+  double recover_min_surface_correlation = 0.0;
   /// -1 = off. At most this many results in a row with status kExtrapolated (KLT failed) can be
   /// good; later ones are bad (quality capped at min_quality / 2) until a result that is not
   /// extrapolated. Not a colour rule: it applies with or without colour evidence.
