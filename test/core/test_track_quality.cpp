@@ -19,6 +19,17 @@ TrackResult refined_result(double energy_after, bool klt_success, double inlier_
   return r;
 }
 
+/// Colour evidence whose surface correlates at `matching`, at `differing`, and is not scored.
+struct SurfaceEvidence {
+  ColorEvidence matching, differing, unscored;
+};
+SurfaceEvidence surface_evidence(double matching, double differing) {
+  SurfaceEvidence e;
+  e.matching.surface_correlation = matching;
+  e.differing.surface_correlation = differing;
+  return e;
+}
+
 TEST(TrackQuality, ScoreMixesEnergyRatioAndInlierRatio) {
   TrackQualityParams params;
   params.energy_weight = 0.7;
@@ -285,9 +296,9 @@ TEST(TrackQuality, ASurfaceThatStillMatchesHoldsABadTrackedFrame) {
   params.energy_level_smoothing = 1.0;  // level = the last good energy
   ColorLossRule rule;
   rule.surface_hold_correlation = 0.7;
-  ColorEvidence matching, differing, unscored;
-  matching.surface_correlation = 0.75;
-  differing.surface_correlation = 0.69;
+  const SurfaceEvidence surface = surface_evidence(0.75, 0.69);
+  const ColorEvidence &matching = surface.matching, &differing = surface.differing,
+                      &unscored = surface.unscored;
   const TrackResult good = refined_result(10.0, true, 0.9);
   const TrackResult blurred = refined_result(2.0, true, 0.2);       // bad: 0.7 * 0.2 + 0.3 * 0.2
   const TrackResult extrapolated = refined_result(2.0, false, 0.0);  // bad, KLT failed
@@ -333,9 +344,9 @@ TEST(TrackQuality, ASurfaceThatDoesNotMatchKeepsTheTrackLost) {
   params.energy_level_smoothing = 1.0;  // level = the last good energy
   ColorLossRule rule;
   rule.recover_min_surface_correlation = 0.3;
-  ColorEvidence matching, differing, unscored;
-  matching.surface_correlation = 0.8;
-  differing.surface_correlation = 0.29;
+  const SurfaceEvidence surface = surface_evidence(0.8, 0.29);
+  const ColorEvidence &matching = surface.matching, &differing = surface.differing,
+                      &unscored = surface.unscored;
   const TrackResult good = refined_result(10.0, true, 1.0);
   const TrackResult bad = refined_result(1.0, false, 0.0);
   TrackResult found = good;
