@@ -108,6 +108,8 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     # a tracked frame whose surface does not correlate with the learned one is not matched
     # against the keyframes' features
     ("realtime_no_surface_relocalization", "realtime", {"relocalization_below_correlation": "0"}),
+    # ... matched around the held pose only, not over the whole frame when nothing is found there
+    ("realtime_no_doubt_whole_frame", "realtime", {"relocalization_doubt_whole_frame": "false"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     # the PnP pose made the most likely pose under a prior on the frame-to-frame motion

@@ -486,8 +486,13 @@ void TrackingSession::use_features(const Frame& frame, const cv::Mat& gray, Sess
     return;
   const Pose& held = result.frame.object_to_camera;
   const PinholeCamera& camera = tracker_->camera();
-  const Relocalization found =
+  Relocalization found =
       relocalizer_->locate(gray, camera, relocalizer_->region_around(held, camera, kRegionMargin));
+  // In doubt by the surface and not found near the held pose, the object may be anywhere: the
+  // whole frame (second: near the held pose ORB's feature budget is spent on the object, over
+  // the whole frame much of it on clutter).
+  if (!found.found && in_doubt && params_.relocalization_doubt_whole_frame)
+    found = relocalizer_->locate(gray, camera);
   if (!found.found) return;
   if (same_place(held, found.object_to_camera, kAgreementDiameters, kAgreementDeg)) {
     features_confirm_ = true;

@@ -129,7 +129,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 111u);
+  EXPECT_EQ(fields.size(), 112u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -185,6 +185,9 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   // ... and on a tracked frame whose surface does not correlate (a doubt), paper never.
   EXPECT_GT(realtime.relocalization_below_correlation, 0.0);
   EXPECT_EQ(make_preset("paper").relocalization_below_correlation, 0.0);
+  // ... there over the whole frame when not found around the held pose.
+  EXPECT_TRUE(realtime.relocalization_doubt_whole_frame);
+  EXPECT_FALSE(make_preset("paper").relocalization_doubt_whole_frame);
   bad = realtime;
   bad.relocalization_below_correlation = 1.5;
   EXPECT_THROW(bad.validate(), std::invalid_argument);

@@ -978,6 +978,46 @@ TEST(TrackingSession, ATrackWhoseSurfaceDisagreesIsRelocalizedByFeatures) {
   }
 }
 
+/// relocalization_doubt_whole_frame: the textured box vanishes for a frame and comes back 18 cm
+/// away. KLT's anchors, laid on the background on the empty frame, hold the old place, whose
+/// surface does not correlate; the other checks that could find the box (the surface's shifts,
+/// turns and alignment, the colour searches of a faded or failed frame) are off. In doubt by the surface, the
+/// keyframe's features are matched over the whole frame and find the box on the first frame
+/// back (never lost); matched only around the held pose, they cannot (the old place is held,
+/// 17 cm off, until the loss).
+TEST(TrackingSession, ASurfaceInDoubtIsLookedForOverTheWholeFrame) {
+  const Scene scene;
+  const Pose start = test::make_pose(0.45);
+  const Pose truth = test::move(start, 0.0, {0.0, 0.0, 1.0}, {0.15, -0.1, 0.0});
+  for (const bool whole_frame : {false, true}) {
+    SCOPED_TRACE(whole_frame ? "whole frame" : "around the held pose");
+    TrackerParams params = quick_realtime();
+    ASSERT_GT(params.relocalization_below_correlation, 0.0);
+    params.tracked_search_ratio = 0.0;
+    params.extrapolated_search_ratio = 0.0;
+    params.texture_check_margin = 2.0;
+    params.texture_align_below = 0.0;
+    params.texture_shift_search_below = 0.0;
+    params.rotation_check_deg = 0.0;
+    params.relocalization_doubt_whole_frame = whole_frame;
+    TrackingSession session(scene.mesh, params);
+    const CheckRun run = hide_and_show(session, scene.renderer, scene.camera, scene.background, start,
+                                       truth, &SessionResult::relocalized);
+    const Pose& first = run.first.frame.object_to_camera;
+    if (whole_frame) {
+      EXPECT_TRUE(run.first.relocalized) << "not relocalized on the first frame back";
+      // 5 mm and 2 deg for a 12 cm box at 0.45 m, as the relocalization tests'.
+      EXPECT_LT(translation_error(first, truth), 0.005);
+      EXPECT_LT(rotation_error_deg(first, truth), 2.0);
+      EXPECT_FALSE(run.lost);
+    } else {
+      EXPECT_FALSE(run.first.relocalized) << "found around the held pose: the test shows nothing";
+      EXPECT_GT(translation_error(first, truth), 0.1);
+      EXPECT_TRUE(run.lost) << "held at the old place until declared lost";
+    }
+  }
+}
+
 /// texture_align_below: a textured cube vanishes for a frame (KLT fails) and comes back at the
 /// same place turned 15 deg about an axis that is none of its own (camera x and y mixed). The
 /// check's turns about the cube's axes and rotation_check's turns about the camera's (off here)

@@ -194,6 +194,16 @@ struct TrackerParams {
   /// untextured one never gives enough features: the option then does nothing).
   bool feature_relocalization = false;
   int relocalization_override_inliers = 25;  ///< PnP inliers needed to replace a held track
+  /// ours (tracking session; false = around the held pose only): a tracked frame in doubt by
+  /// its surface (relocalization_below_correlation) whose features are not found around the
+  /// held pose is matched against the keyframes over the whole frame as well. A surface that
+  /// disagrees says the held pose may not be on the object at all, and then the object is
+  /// anywhere: hard/can/leave, after the can left the image a blue patch 6-7 diameters away
+  /// was re-acquired and held by 45 KLT inliers, its surface at 0.0-0.04, and the can, back in
+  /// view, was never looked for where it was. The held pose's region is tried first: over the
+  /// whole frame ORB's feature budget goes mostly to clutter (searched there alone, hard
+  /// can clutter and hard2 can occlusion lost their finds: -3.4 to -4.0).
+  bool relocalization_doubt_whole_frame = false;
   /// With feature_relocalization: false = features are matched only while lost (to re-acquire;
   /// keyframes then only from the given poses, since a new one must be confirmed by the
   /// tracked frame's match), which costs nothing while tracking. true = also on every tracked

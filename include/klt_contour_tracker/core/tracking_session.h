@@ -200,7 +200,9 @@ class TrackingSession {
   void count(const SessionResult& result);
   /// feature_relocalization, on a frame the pipeline tracked (`gray` undistorted): the
   /// keyframes' features around the held pose confirm it, or replace it when they disagree
-  /// and the track is in doubt (KLT failed, the last frame was bad, or `in_doubt`).
+  /// and the track is in doubt (KLT failed, the last frame was bad, or `in_doubt`: the
+  /// surface disagrees; then, with relocalization_doubt_whole_frame, over the whole frame
+  /// when nothing was found around it).
   void use_features(const Frame& frame, const cv::Mat& gray, SessionResult& result,
                     bool in_doubt = false);
   /// relocalization_below_correlation: the tracked frame `result`'s surface (a colour
