@@ -931,6 +931,15 @@ TEST(TrackingSession, TextureCheckFindsATurnAboutTheObjectsAxis) {
     }
 }
 
+/// The checks that correct a held pose by itself off: the texture check's turns (a margin no
+/// correlation reaches), the surface's shifts and alignment, rotation_check's turns.
+void without_pose_corrections(TrackerParams& params) {
+  params.texture_check_margin = 2.0;
+  params.texture_align_below = 0.0;
+  params.texture_shift_search_below = 0.0;
+  params.rotation_check_deg = 0.0;
+}
+
 /// relocalization_below_correlation: the textured box vanishes for a frame (KLT fails) and comes
 /// back turned 180 deg about its own axis nearest the line of sight: the same outline (the box is
 /// symmetric), other faces' patterns. With the checks that could find the turn off (the texture
@@ -952,10 +961,7 @@ TEST(TrackingSession, ATrackWhoseSurfaceDisagreesIsRelocalizedByFeatures) {
   for (const bool doubt : {false, true}) {
     SCOPED_TRACE(doubt ? "with the rule" : "without the rule");
     TrackerParams params = quick_realtime();
-    params.texture_check_margin = 2.0;
-    params.texture_align_below = 0.0;
-    params.texture_shift_search_below = 0.0;
-    params.rotation_check_deg = 0.0;
+    without_pose_corrections(params);
     params.relocalization_below_correlation = doubt ? make_preset("realtime").relocalization_below_correlation : 0.0;
     TrackingSession session(scene.mesh, params);
     const CheckRun run = hide_and_show(session, scene.renderer, scene.camera, scene.background, start,
@@ -995,10 +1001,7 @@ TEST(TrackingSession, ASurfaceInDoubtIsLookedForOverTheWholeFrame) {
     ASSERT_GT(params.relocalization_below_correlation, 0.0);
     params.tracked_search_ratio = 0.0;
     params.extrapolated_search_ratio = 0.0;
-    params.texture_check_margin = 2.0;
-    params.texture_align_below = 0.0;
-    params.texture_shift_search_below = 0.0;
-    params.rotation_check_deg = 0.0;
+    without_pose_corrections(params);
     params.relocalization_doubt_whole_frame = whole_frame;
     TrackingSession session(scene.mesh, params);
     const CheckRun run = hide_and_show(session, scene.renderer, scene.camera, scene.background, start,
