@@ -262,7 +262,7 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
     if (refined.front().status != TrackStatus::kReacquired) return refined.front();  // invalid frame
     std::vector<Pose> refined_poses;
     for (const TrackResult& r : refined) refined_poses.push_back(r.object_to_camera);
-    const std::vector<SearchCandidate> scored = search_->score(bgr, refined_poses, camera);
+    const std::vector<SearchCandidate> scored = score_once(bgr, refined_poses);
     // A hypothesis the refinement took out of reach is not a candidate (the last good pose,
     // the first, is the fallback).
     const auto candidate = [&](std::size_t i) { return i == 0 || within_reach(refined_poses[i], reach_px); };
@@ -329,12 +329,12 @@ TrackResult TrackingSession::reacquire(const Frame& frame, const cv::Mat& bgr, b
 }
 
 void TrackingSession::keep_best_placements(const cv::Mat& bgr, std::size_t first_placed,
-                                           std::vector<Pose>& hypotheses) const {
+                                           std::vector<Pose>& hypotheses) {
   const auto keep = static_cast<std::size_t>(params_.color_search_refined);
   if (keep == 0 || hypotheses.size() - first_placed <= keep) return;
   const std::vector<Pose> placed(hypotheses.begin() + static_cast<std::ptrdiff_t>(first_placed),
                                  hypotheses.end());
-  const std::vector<SearchCandidate> scored = search_->score(bgr, placed, tracker_->camera());
+  const std::vector<SearchCandidate> scored = score_once(bgr, placed);
   std::vector<std::size_t> order(placed.size());
   std::iota(order.begin(), order.end(), 0);
   // Best contrast first; a tie keeps the search's order.
@@ -404,6 +404,34 @@ std::vector<TrackResult> TrackingSession::refine_once(const Frame& frame,
     frame_search_.refined.push_back(done[k]);
   }
   return refined;
+}
+
+std::vector<SearchCandidate> TrackingSession::score_once(const cv::Mat& bgr,
+                                                         const std::vector<Pose>& poses) {
+  std::vector<SearchCandidate> scores(poses.size());
+  std::vector<Pose> fresh;
+  std::vector<std::size_t> fresh_index;
+  const auto& scored = frame_search_.scored;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const auto same = std::find_if(scored.begin(), scored.end(), [&](const Pose& pose) {
+      return pose.matrix() == poses[i].matrix();
+    });
+    if (same != scored.end()) {
+      scores[i] = frame_search_.scores[static_cast<std::size_t>(same - scored.begin())];
+    } else {
+      fresh.push_back(poses[i]);
+      fresh_index.push_back(i);
+    }
+  }
+  if (fresh.empty()) return scores;
+  // One batch: the poses are scored in parallel.
+  const std::vector<SearchCandidate> done = search_->score(bgr, fresh, tracker_->camera());
+  for (std::size_t k = 0; k < done.size(); ++k) {
+    scores[fresh_index[k]] = done[k];
+    frame_search_.scored.push_back(fresh[k]);
+    frame_search_.scores.push_back(done[k]);
+  }
+  return scores;
 }
 
 bool TrackingSession::repeats_previous_find(const SessionResult& result) {
@@ -532,7 +560,7 @@ void TrackingSession::search_if_faded(const Frame& frame, const cv::Mat& bgr, Se
   // The held pose's colours, for use_colors; a check that ran before (check_rotation) has
   // scored them already.
   if (!result.color.valid)
-    result.color = evidence_of(search_->score(bgr, held.object_to_camera, tracker_->camera()));
+    result.color = evidence_of(score_once(bgr, held.object_to_camera));
   const double held_contrast = result.color.contrast;
   const double level = monitor_.color_level();
   if (!(held_contrast < ratio * level)) return;
@@ -569,7 +597,7 @@ void TrackingSession::check_rotation(const Frame& frame, const cv::Mat& bgr, Ses
   std::vector<TrackResult> refined = tracker_->refine_hypotheses(frame, turned, 1.0, false);
   std::vector<Pose> poses{held.object_to_camera};
   for (const TrackResult& r : refined) poses.push_back(r.object_to_camera);
-  const std::vector<SearchCandidate> scored = search_->score(bgr, poses, tracker_->camera());
+  const std::vector<SearchCandidate> scored = score_once(bgr, poses);
   const Eigen::Vector3d& center = tracker_->center_object();
   const Eigen::Vector3d held_center = held.object_to_camera * center;
   std::size_t best = 0;
@@ -665,7 +693,7 @@ void TrackingSession::check_texture(const Frame& frame, const cv::Mat& bgr, Sess
   // often scrambles; its contour energy is then the held pose's.
   TrackResult refined = tracker_->refine_hypotheses(frame, {best_pose}, 1.0).front();
   const std::vector<SearchCandidate> colors =
-      search_->score(bgr, {held_pose, refined.object_to_camera, best_pose}, camera);
+      score_once(bgr, {held_pose, refined.object_to_camera, best_pose});
   const double level = monitor_.color_level();
   const auto kept_place = [&](const Pose& p) {
     return (p * center - held_center).norm() < kRotationCheckMaxShiftDiameters * tracker_->diameter_m();
@@ -745,7 +773,7 @@ bool TrackingSession::take_if_surface_agrees(const Frame& frame, const cv::Mat& 
   const TrackResult& held = result.frame;
   const PinholeCamera& camera = tracker_->camera();
   TrackResult refined = tracker_->refine_hypotheses(frame, {found}, 1.0, shift_search).front();
-  const SearchCandidate colors = search_->score(bgr, refined.object_to_camera, camera);
+  const SearchCandidate colors = score_once(bgr, refined.object_to_camera);
   const TextureAgreement agreement =
       texture_->agreement(prepared, refined.object_to_camera, camera);
   if (!refined.refined || agreement.points < SurfaceTexture::kMinPoints ||
@@ -782,7 +810,7 @@ void TrackingSession::use_colors(const cv::Mat& bgr, SessionResult& result) {
     return;
   }
   if (!search_->ready() || result.color.valid) return;  // valid: scored by check_rotation
-  result.color = evidence_of(search_->score(bgr, pose, tracker_->camera()));
+  result.color = evidence_of(score_once(bgr, pose));
 }
 
 SessionResult TrackingSession::track(const Frame& frame) {

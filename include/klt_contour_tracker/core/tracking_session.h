@@ -270,7 +270,7 @@ class TrackingSession {
   /// color_search_refined: of hypotheses[first_placed..] (the colour placements and their
   /// turns), keeps the color_search_refined with the best colour contrast in `bgr`, in order.
   void keep_best_placements(const cv::Mat& bgr, std::size_t first_placed,
-                            std::vector<Pose>& hypotheses) const;
+                            std::vector<Pose>& hypotheses);
   /// Depth (m, along the camera axis) of the object's centre at `object_to_camera`.
   double center_depth_m(const Pose& object_to_camera) const;
   /// trusted_depth_ratio: `object_to_camera`'s centre lies outside the trusted depth range.
@@ -293,6 +293,8 @@ class TrackingSession {
     std::vector<SearchCandidate> found;  ///< ObjectSearch::search(), before any cut
     std::vector<Pose> starts;            ///< refined hypotheses ...
     std::vector<TrackResult> refined;    ///< ... and their refinements
+    std::vector<Pose> scored;             ///< poses whose colours were scored ...
+    std::vector<SearchCandidate> scores;  ///< ... and their scores
   };
   FrameSearch frame_search_;
   bool record_hypotheses_ = false;                 ///< see set_record_hypotheses()
@@ -305,6 +307,14 @@ class TrackingSession {
   /// reacquire()'s refinement of `hypotheses` (search scale 1), from frame_search_ where a
   /// start was refined on this frame already.
   std::vector<TrackResult> refine_once(const Frame& frame, const std::vector<Pose>& hypotheses);
+  /// ObjectSearch::score() of `poses` on this frame, from frame_search_ where a pose was scored
+  /// on this frame already (a lost frame scores its placements and refined hypotheses again
+  /// when the pipeline's extrapolated pose is searched from: a pure function of the frame, the
+  /// pose and the colour model, which is learned only after the frame's checks).
+  std::vector<SearchCandidate> score_once(const cv::Mat& bgr, const std::vector<Pose>& poses);
+  SearchCandidate score_once(const cv::Mat& bgr, const Pose& pose) {
+    return score_once(bgr, std::vector<Pose>{pose}).front();
+  }
   SessionStatistics statistics_;
 };
 
