@@ -93,6 +93,38 @@ std::vector<Pose> turned_about_center(const Pose& pose, const Eigen::Vector3d& c
   return turned;
 }
 
+/// A frame's memo of a batch computation on poses (refine_once, score_once): the values for
+/// `poses`, from (keys, values) where a pose (exactly the same) was done on this frame already;
+/// the others computed in one batch by `compute` and remembered when `keep` accepts them.
+template <typename Value, typename Compute, typename Keep>
+std::vector<Value> once_per_frame(const std::vector<Pose>& poses, std::vector<Pose>& keys,
+                                  std::vector<Value>& values, const Compute& compute,
+                                  const Keep& keep) {
+  std::vector<Value> out(poses.size());
+  std::vector<Pose> fresh;
+  std::vector<std::size_t> fresh_index;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const auto same = std::find_if(keys.begin(), keys.end(), [&](const Pose& key) {
+      return key.matrix() == poses[i].matrix();
+    });
+    if (same != keys.end()) {
+      out[i] = values[static_cast<std::size_t>(same - keys.begin())];
+    } else {
+      fresh.push_back(poses[i]);
+      fresh_index.push_back(i);
+    }
+  }
+  if (fresh.empty()) return out;
+  const std::vector<Value> done = compute(fresh);
+  for (std::size_t k = 0; k < done.size(); ++k) {
+    out[fresh_index[k]] = done[k];
+    if (!keep(done[k])) continue;
+    keys.push_back(fresh[k]);
+    values.push_back(done[k]);
+  }
+  return out;
+}
+
 }  // namespace
 
 bool SessionResult::has_pose() const {
@@ -379,59 +411,20 @@ TrackResult TrackingSession::refine_from(const Frame& frame, const Pose& start) 
 
 std::vector<TrackResult> TrackingSession::refine_once(const Frame& frame,
                                                      const std::vector<Pose>& hypotheses) {
-  std::vector<TrackResult> refined(hypotheses.size());
-  std::vector<Pose> fresh;
-  std::vector<std::size_t> fresh_index;
-  for (std::size_t i = 0; i < hypotheses.size(); ++i) {
-    const auto& starts = frame_search_.starts;
-    const auto same = std::find_if(starts.begin(), starts.end(), [&](const Pose& start) {
-      return start.matrix() == hypotheses[i].matrix();
-    });
-    if (same != starts.end()) {
-      refined[i] = frame_search_.refined[static_cast<std::size_t>(same - starts.begin())];
-    } else {
-      fresh.push_back(hypotheses[i]);
-      fresh_index.push_back(i);
-    }
-  }
-  if (fresh.empty()) return refined;
-  const std::vector<TrackResult> done = tracker_->refine_hypotheses(frame, fresh, 1.0);
-  for (std::size_t k = 0; k < done.size(); ++k) {
-    refined[fresh_index[k]] = done[k];
-    // An invalid frame's results are not kept: every later call reports it again.
-    if (done[k].status != TrackStatus::kReacquired) continue;
-    frame_search_.starts.push_back(fresh[k]);
-    frame_search_.refined.push_back(done[k]);
-  }
-  return refined;
+  return once_per_frame(
+      hypotheses, frame_search_.starts, frame_search_.refined,
+      [&](const std::vector<Pose>& fresh) { return tracker_->refine_hypotheses(frame, fresh, 1.0); },
+      // An invalid frame's results are not kept: every later call reports it again.
+      [](const TrackResult& r) { return r.status == TrackStatus::kReacquired; });
 }
 
 std::vector<SearchCandidate> TrackingSession::score_once(const cv::Mat& bgr,
                                                          const std::vector<Pose>& poses) {
-  std::vector<SearchCandidate> scores(poses.size());
-  std::vector<Pose> fresh;
-  std::vector<std::size_t> fresh_index;
-  const auto& scored = frame_search_.scored;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    const auto same = std::find_if(scored.begin(), scored.end(), [&](const Pose& pose) {
-      return pose.matrix() == poses[i].matrix();
-    });
-    if (same != scored.end()) {
-      scores[i] = frame_search_.scores[static_cast<std::size_t>(same - scored.begin())];
-    } else {
-      fresh.push_back(poses[i]);
-      fresh_index.push_back(i);
-    }
-  }
-  if (fresh.empty()) return scores;
-  // One batch: the poses are scored in parallel.
-  const std::vector<SearchCandidate> done = search_->score(bgr, fresh, tracker_->camera());
-  for (std::size_t k = 0; k < done.size(); ++k) {
-    scores[fresh_index[k]] = done[k];
-    frame_search_.scored.push_back(fresh[k]);
-    frame_search_.scores.push_back(done[k]);
-  }
-  return scores;
+  return once_per_frame(
+      poses, frame_search_.scored, frame_search_.scores,
+      // One batch: the poses are scored in parallel.
+      [&](const std::vector<Pose>& fresh) { return search_->score(bgr, fresh, tracker_->camera()); },
+      [](const SearchCandidate&) { return true; });
 }
 
 bool TrackingSession::repeats_previous_find(const SessionResult& result) {
