@@ -110,6 +110,9 @@ ABLATIONS = [  # label, preset, --param overrides: the default with and without 
     ("realtime_no_surface_relocalization", "realtime", {"relocalization_below_correlation": "0"}),
     # ... matched around the held pose only, not over the whole frame when nothing is found there
     ("realtime_no_doubt_whole_frame", "realtime", {"relocalization_doubt_whole_frame": "false"}),
+    # while lost, the pipeline's pose also goes through rotation_check and texture_check (a
+    # lost frame's time, not a cue: the same poses but for a few runs, lost frames slower)
+    ("realtime_check_while_lost", "realtime", {"check_while_lost": "true"}),
     # cues that exist but are off by default (measured worse; shown so that it stays visible)
     ("realtime_region", "realtime", {"region_weight": "1"}),
     # the PnP pose made the most likely pose under a prior on the frame-to-frame motion

@@ -855,8 +855,11 @@ SessionResult TrackingSession::track(const Frame& frame) {
     if (!gray.empty() && params_.relocalization_while_tracking) use_features(frame, gray, result);
     if (result.frame.status == TrackStatus::kExtrapolated)
       search_if_faded(frame, bgr, result, params_.extrapolated_search_ratio, false);
-    check_rotation(frame, bgr, result);  // only on tracked frames (kKeypoints, kExtrapolated)
-    if (!result.rotation_corrected) check_texture(frame, bgr, result);
+    // Only on tracked frames (kKeypoints, kExtrapolated); while lost, with check_while_lost.
+    if (!result.reacquiring || params_.check_while_lost) {
+      check_rotation(frame, bgr, result);
+      if (!result.rotation_corrected) check_texture(frame, bgr, result);
+    }
     // After the checks: a turn or a shift they found is the held pose's own correction, while
     // the colour search may take another place.
     if (result.frame.status == TrackStatus::kKeypoints && !result.rotation_corrected &&

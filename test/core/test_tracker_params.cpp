@@ -129,7 +129,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 112u);
+  EXPECT_EQ(fields.size(), 113u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 

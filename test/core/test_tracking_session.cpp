@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -874,6 +875,47 @@ TEST(TrackingSession, RotationCheckCorrectsAWrongRotationTheTrackHolds) {
         EXPECT_EQ(corrections, 1) << what;
       }
     }
+}
+
+/// check_while_lost: the red box is hidden for a frame and comes back 20 deg turned, but the
+/// monitor keeps the session LOST (every frame bad but the first few: the energy ratio alone,
+/// good only at or above its level) and the colour search takes nothing (it must beat the colour
+/// level itself, with no confirmation by a second frame), so each lost frame's pose is the
+/// pipeline's. With the checks while lost, texture_check scores every such frame's pose against
+/// the learned surface (the correlation it reports); without them none is scored.
+TEST(TrackingSession, WhileLostTheHeldPoseIsCheckedOnlyWhenAsked) {
+  const ColourScene scene;
+  const Pose truth = test::move(scene.start, 20.0, Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero());
+  ASSERT_FALSE(make_preset("realtime").check_while_lost) << "realtime does not check while lost";
+  TrackQualityParams quality;
+  quality.min_quality = 1.0;
+  quality.energy_weight = 1.0;
+  for (const bool check : {true, false}) {
+    TrackerParams params = quick_realtime();
+    params.check_while_lost = check;
+    params.feature_relocalization = false;
+    params.color_accept_ratio = 1.0;
+    params.color_confirm_ratio = 0.0;
+    TrackingSession session(scene.mesh, params, quality);
+    session.set_camera(scene.camera);
+    session.initialize(scene.start);
+    int pipeline_frames = 0, scored = 0;
+    for (int i = 0; i < 17; ++i) {
+      const cv::Mat image =
+          i == 8 ? scene.background.clone()
+                 : test::render_frame(scene.renderer, scene.camera, i < 8 ? scene.start : truth,
+                                      scene.background, 1.5, i);
+      const SessionResult r = session.track({image, 0.033 * i});
+      if (!r.reacquiring || r.searched) continue;
+      ASSERT_TRUE(r.frame.status == TrackStatus::kKeypoints || r.frame.status == TrackStatus::kExtrapolated)
+          << i;
+      ++pipeline_frames;
+      scored += std::isfinite(r.texture_correlation) ? 1 : 0;
+    }
+    const std::string what = check ? "with the checks while lost" : "without them";
+    ASSERT_GE(pipeline_frames, 4) << what << ": the session must be lost on the pipeline's poses";
+    EXPECT_EQ(scored, check ? pipeline_frames : 0) << what;
+  }
 }
 
 /// The texture tests' scene: a randomly textured 10 cm cube (centred at its origin) over the

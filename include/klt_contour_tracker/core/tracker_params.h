@@ -238,6 +238,11 @@ struct TrackerParams {
   /// 20 deg 11.45 but one correction turned a right chest 30 deg; checked on every frame (20 deg)
   /// 11.28: 4 of 14 corrections made the pose worse, and the median frame time was 6x.
   double rotation_check_deg = 0.0;
+  /// ours (tracking session; realtime false): while LOST, a frame the searches did not
+  /// re-acquire (track_while_lost's pipeline pose) is also put through rotation_check and
+  /// texture_check. Off, a lost frame spends its time on the searches for the object, which
+  /// re-acquire it, and not on correcting a pose already judged lost.
+  bool check_while_lost = true;
   int rotation_check_frames = 5;       ///< see rotation_check_deg
   double rotation_check_margin = 0.1;  ///< see rotation_check_deg
   /// ours (tracking session, 0 = off; needs color_search): the object's surface colours are
