@@ -241,7 +241,8 @@ struct TrackerParams {
   /// ours (tracking session; realtime false): while LOST, a frame the searches did not
   /// re-acquire (track_while_lost's pipeline pose) is also put through rotation_check and
   /// texture_check. Off, a lost frame spends its time on the searches for the object, which
-  /// re-acquire it, and not on correcting a pose already judged lost.
+  /// re-acquire it, and not on correcting a pose already judged lost. (Without texture_check's
+  /// correlation such a frame's tracked search has no tracked_search_surface_drop bar.)
   bool check_while_lost = true;
   int rotation_check_frames = 5;       ///< see rotation_check_deg
   double rotation_check_margin = 0.1;  ///< see rotation_check_deg
