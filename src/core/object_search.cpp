@@ -288,8 +288,8 @@ ObjectSearch::SilhouetteTemplate ObjectSearch::silhouette_template(
   const double area = cv::countNonZero(mask);
   if (area < 4) return t;
   const cv::Mat ring = silhouette_ring(mask, ring_width_px(mask, settings_.ring_fraction));
-  mask.convertTo(t.inside, CV_32F, 1.0 / 255.0);
-  ring.convertTo(t.ring, CV_32F, 1.0 / 255.0);
+  t.inside = MaskRuns::of(mask);
+  t.ring = MaskRuns::of(ring);
   cv::integral(mask / 255, t.inside_integral, CV_32S);
   cv::integral(ring / 255, t.ring_integral, CV_32S);
   t.half = half;
@@ -313,9 +313,10 @@ cv::Mat ObjectSearch::contrast_map(const cv::Mat& posterior, const SilhouetteTem
   cv::copyMakeBorder(posterior(inside), window, inside.y - needed.y,
                      needed.br().y - inside.br().y, inside.x - needed.x,
                      needed.br().x - inside.br().x, cv::BORDER_CONSTANT, 0);
-  cv::Mat posterior_inside, posterior_ring;  // index (c, r): centre centres.tl() + (c, r)
-  cv::matchTemplate(window, silhouette.inside, posterior_inside, cv::TM_CCORR);
-  cv::matchTemplate(window, silhouette.ring, posterior_ring, cv::TM_CCORR);
+  // index (c, r): centre centres.tl() + (c, r)
+  const cv::Mat prefix = row_prefix_sums(window);
+  const cv::Mat posterior_inside = correlate_mask(prefix, silhouette.inside);
+  const cv::Mat posterior_ring = correlate_mask(prefix, silhouette.ring);
   // Template pixels of the placement centred on image pixel (c, r) that fall in the image.
   auto in_image = [&](const cv::Mat& integral, int r, int c) {
     const int j0 = std::max(0, half - r), j1 = std::min(side, half - r + posterior.rows);

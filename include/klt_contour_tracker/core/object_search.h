@@ -7,12 +7,12 @@
 ///
 /// Colours are learned at trusted poses (ColorHistograms, SRT3D's model). The search renders the
 /// object's silhouette at the last good rotation and a few depths and correlates it, as a
-/// template, with the frame's per-pixel foreground posterior (cv::matchTemplate): the score of a
+/// template, with the frame's per-pixel foreground posterior (correlate_mask): the score of a
 /// placement is the mean posterior inside the silhouette minus the mean in a ring around it, over
 /// the pixels in the image, so an object entering the image is found once part of it is in.
 /// Coarse to fine: the whole frame is correlated at half the working size and its best peaks
-/// again at the working size around them (matchTemplate over the whole working frame was a
-/// quarter of a lost frame's time).
+/// again at the working size around them (cv::matchTemplate over the whole working frame was a
+/// quarter of a lost frame's time; mask_correlation.h says why it is no longer matchTemplate).
 
 #include <memory>
 #include <opencv2/core.hpp>
@@ -20,6 +20,7 @@
 
 #include "klt_contour_tracker/core/camera.h"
 #include "klt_contour_tracker/core/color_histograms.h"
+#include "klt_contour_tracker/core/mask_correlation.h"
 #include "klt_contour_tracker/core/mesh.h"
 #include "klt_contour_tracker/core/pose.h"
 #include "klt_contour_tracker/core/renderer.h"
@@ -120,7 +121,8 @@ class ObjectSearch {
   struct SilhouetteTemplate {
     int half = 0, side = 0;
     double area = 0.0;  ///< silhouette pixels
-    cv::Mat inside, ring, inside_integral, ring_integral;
+    MaskRuns inside, ring;  ///< the silhouette's and the ring's pixels, as runs
+    cv::Mat inside_integral, ring_integral;
     bool empty() const { return area <= 0.0; }
   };
   /// The silhouette of `reference`'s rotation at `depth_m` seen by `working_camera` (whose image
