@@ -174,7 +174,9 @@ TEST(Renderer, TextureIsPerspectiveCorrectAndUpright) {
   ASSERT_GT(std::abs(mid_u - affine_mid_u), 5.0);
   const int top = static_cast<int>(kCamera.project(pose * Eigen::Vector3d(0, 0.5 * h, 0)).y());
   const int bottom = static_cast<int>(kCamera.project(pose * Eigen::Vector3d(0, -0.5 * h, 0)).y());
-  auto color_at = [&](double x, int y) { return out.color.at<cv::Vec3b>(y, static_cast<int>(std::lround(x))); };
+  auto color_at = [&](double x, int y) {
+    return out.color.at<cv::Vec3b>(y, static_cast<int>(std::lround(x)));
+  };
   EXPECT_EQ(color_at(mid_u - 2, top), cv::Vec3b(0, 0, 255));
   EXPECT_EQ(color_at(mid_u + 2, top), cv::Vec3b(0, 255, 0));
   EXPECT_EQ(color_at(mid_u - 2, bottom), cv::Vec3b(255, 0, 0));
@@ -258,8 +260,8 @@ TEST(Renderer, SpecularHighlightIsWhereTheHalfVectorMeetsTheNormal) {
   options.shininess = 50.0;
   const cv::Mat shiny = renderer.render(pose, kCamera, options).color;
   const auto grey = [](const cv::Mat& image, int x, int y) { return image.at<cv::Vec3b>(y, x)[1]; };
-  EXPECT_EQ(grey(flat, 320, 240), grey(flat, 20, 20));  // flat: uniform
-  EXPECT_GT(grey(shiny, 320, 240), grey(flat, 320, 240) + 60);  // highlight at the centre
+  EXPECT_EQ(grey(flat, 320, 240), grey(flat, 20, 20));                // flat: uniform
+  EXPECT_GT(grey(shiny, 320, 240), grey(flat, 320, 240) + 60);        // highlight at the centre
   EXPECT_LT(std::abs(grey(shiny, 20, 20) - grey(flat, 20, 20)), 15);  // none at the corner
   // Defaults unchanged: the per-pixel path is off unless asked for.
   EXPECT_EQ(cv::norm(renderer.render(pose, kCamera).color,
@@ -326,4 +328,45 @@ TEST(Renderer, SilhouetteIsTheDepthTestedRendersMask) {
     }
   }
   EXPECT_GE(compared, 10);  // most cases draw something
+}
+
+TEST(Renderer, SilhouetteOfRandomTrianglesIsTheDepthTestedRendersMask) {
+  // Any triangle (slivers, near-horizontal and near-vertical edges, ones about a pixel across,
+  // ones reaching out of the image or through the near plane) covers exactly the pixels in the
+  // silhouette that it covers in the depth-tested render (the colour search scores poses by
+  // silhouettes, the rest of the tracker reads the depth-tested render).
+  cv::RNG rng(12345);
+  auto mesh = std::make_shared<kct::Mesh>();
+  const auto random_point = [&](double spread) {
+    return Eigen::Vector3d(rng.uniform(-spread, spread), rng.uniform(-spread, spread),
+                           rng.uniform(-spread, spread));
+  };
+  for (int i = 0; i < 150; ++i) {
+    const Eigen::Vector3d a = random_point(0.1);
+    Eigen::Vector3d b = a + random_point(0.08), c = a + random_point(0.08);
+    if (i % 5 == 1) c = a + 0.999 * (b - a) + random_point(1e-4);              // a sliver
+    if (i % 5 == 2) b = a + Eigen::Vector3d(rng.uniform(-0.1, 0.1), 1e-7, 0);  // near-horizontal
+    if (i % 5 == 3) b = a + Eigen::Vector3d(1e-7, rng.uniform(-0.1, 0.1), 0);  // near-vertical
+    if (i % 5 == 4) {  // about a pixel across
+      b = a + random_point(3e-4);
+      c = a + random_point(3e-4);
+    }
+    const int first = static_cast<int>(mesh->vertices.size());
+    mesh->vertices.insert(mesh->vertices.end(), {a, b, c});
+    mesh->faces.emplace_back(first, first + 1, first + 2);
+  }
+  const kct::Renderer renderer(mesh);
+  kct::RenderOptions options;
+  options.draw_color = false;
+  for (int k = 0; k < 12; ++k) {
+    // Whole in view (0.4 m), partly out of the image (0.25 m), through the near plane (0.05 m).
+    const double z = k % 3 == 0 ? 0.4 : k % 3 == 1 ? 0.25 : 0.05;
+    const kct::Pose pose =
+        make_pose(random_point(1.0) + Eigen::Vector3d(0, 0, 1.5), rng.uniform(0.0, 3.0),
+                  {rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), z});
+    const cv::Mat expected = renderer.render(pose, kCamera, options).mask();
+    const cv::Mat silhouette = renderer.render_silhouette(pose, kCamera);
+    ASSERT_GT(cv::countNonZero(expected), 0) << "pose " << k;
+    EXPECT_EQ(cv::countNonZero(silhouette != expected), 0) << "pose " << k;
+  }
 }
