@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "klt_contour_tracker/core/check_range.h"
 #include "klt_contour_tracker/core/worker_threads.h"
@@ -248,25 +249,14 @@ cv::Mat silhouette_ring(const cv::Mat& mask, int ring_px) {
   // The union of the disc's rows around every run of mask pixels in a row: each run paints,
   // for each row offset, one span (memset) widened by that row's half-width.
   cv::Mat dilated(mask.size(), CV_8UC1, cv::Scalar(0));
-  for (int y = 0; y < mask.rows; ++y) {
-    const uchar* m = mask.ptr<uchar>(y);
-    for (int x = 0; x < mask.cols;) {
-      if (!m[x]) {
-        ++x;
-        continue;
-      }
-      const int run_start = x;
-      while (x < mask.cols && m[x]) ++x;
-      const int run_end = x - 1;
-      for (int j = 0; j < element.rows; ++j) {
-        const int yy = y + j - ring_px;
-        if (half_width[j] < 0 || yy < 0 || yy >= mask.rows) continue;
-        const int from = std::max(0, run_start - half_width[j]);
-        const int to = std::min(mask.cols - 1, run_end + half_width[j]);
-        std::memset(dilated.ptr<uchar>(yy) + from, 255, static_cast<std::size_t>(to - from + 1));
-      }
+  for (const MaskRuns::Run& run : MaskRuns::of(mask).runs)
+    for (int j = 0; j < element.rows; ++j) {
+      const int yy = run.row + j - ring_px;
+      if (half_width[j] < 0 || yy < 0 || yy >= mask.rows) continue;
+      const int from = std::max(0, run.begin - half_width[j]);
+      const int to = std::min(mask.cols - 1, run.end - 1 + half_width[j]);
+      std::memset(dilated.ptr<uchar>(yy) + from, 255, static_cast<std::size_t>(to - from + 1));
     }
-  }
   return dilated & ~mask;
 }
 
@@ -285,10 +275,11 @@ ObjectSearch::SilhouetteTemplate ObjectSearch::silhouette_template(
   const Pose centred =
       placed_at(reference, center_object_, canvas_camera, Eigen::Vector2d(half, half), depth_m);
   const cv::Mat mask = renderer_.render_silhouette(centred, canvas_camera);
-  const double area = cv::countNonZero(mask);
+  MaskRuns inside = MaskRuns::of(mask);
+  const double area = static_cast<double>(inside.pixels);
   if (area < 4) return t;
   const cv::Mat ring = silhouette_ring(mask, ring_width_px(mask, settings_.ring_fraction));
-  t.inside = MaskRuns::of(mask);
+  t.inside = std::move(inside);
   t.ring = MaskRuns::of(ring);
   cv::integral(mask / 255, t.inside_integral, CV_32S);
   cv::integral(ring / 255, t.ring_integral, CV_32S);
