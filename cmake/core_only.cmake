@@ -11,6 +11,7 @@ find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs calib3d video f
 find_package(Eigen3 REQUIRED)
 find_package(NLopt REQUIRED)
 find_package(assimp REQUIRED)
+find_package(meshoptimizer REQUIRED)
 
 option(KCT_SANITIZE "Build with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)
 option(KCT_FUZZ "Build the libFuzzer targets (clang)" OFF)

@@ -12,7 +12,7 @@ PACKAGES=(
   librostest-dev python3-rostest librosbag-dev python3-rosbag python3-roslaunch
   python3-rosmaster rosout python3-rostopic python3-rosnode rosbash
   python3-geometry-msgs python3-sensor-msgs python3-tf2-msgs
-  libgtest-dev libopencv-dev libeigen3-dev libnlopt-cxx-dev libassimp-dev
+  libgtest-dev libopencv-dev libeigen3-dev libnlopt-cxx-dev libassimp-dev libmeshoptimizer-dev
   opencv-doc cmake g++ make
   clang libfuzzer-14-dev libclang-rt-14-dev
 )

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "klt_contour_tracker/core/check_range.h"
+#include "klt_contour_tracker/core/mesh_simplification.h"
 #include "klt_contour_tracker/core/worker_threads.h"
 
 namespace kct {
@@ -54,14 +55,30 @@ void ObjectSearchSettings::validate() const {
   for (double s : depth_scales) check_range(kOwner, "depth_scales[i]", s, 0.05, 20.0);
   check_range(kOwner, "min_visible_fraction", min_visible_fraction, 1e-3, 1.0);
   check_range(kOwner, "ring_fraction", ring_fraction, 0.01, 2.0);
+  check_range(kOwner, "silhouette_error_diameters", silhouette_error_diameters, 0.0, 0.05);
   check_range(kOwner, "threads", threads, 1, 64);
 }
 
+namespace {
+
+/// `mesh` after checking it and the settings (ObjectSearch's first members need both).
+std::shared_ptr<const Mesh> checked(std::shared_ptr<const Mesh> mesh,
+                                    const ObjectSearchSettings& settings) {
+  if (!mesh || mesh->faces.empty()) throw std::invalid_argument("ObjectSearch: empty mesh");
+  settings.validate();
+  return mesh;
+}
+
+}  // namespace
+
 ObjectSearch::ObjectSearch(std::shared_ptr<const Mesh> mesh, const ObjectSearchSettings& settings)
-    : mesh_(std::move(mesh)), renderer_(mesh_), settings_(settings) {
-  if (!mesh_ || mesh_->faces.empty()) throw std::invalid_argument("ObjectSearch: empty mesh");
-  settings_.validate();
-  diameter_m_ = mesh_->diameter();
+    : mesh_(checked(std::move(mesh), settings)),
+      settings_(settings),
+      diameter_m_(mesh_->diameter()),
+      renderer_(settings_.silhouette_error_diameters > 0.0
+                    ? std::make_shared<const Mesh>(simplified_mesh(
+                          *mesh_, settings_.silhouette_error_diameters * diameter_m_))
+                    : mesh_) {
   center_object_ = mesh_->bounding_box_center();
   box_object_ = mesh_->bounding_box();
   workers_ = std::make_unique<WorkerThreads>(settings_.threads);

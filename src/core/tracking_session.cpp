@@ -154,6 +154,7 @@ void TrackingSession::set_camera(const PinholeCamera& camera) {
 std::unique_ptr<ObjectSearch> TrackingSession::make_search() const {
   ObjectSearchSettings settings;
   settings.threads = params_.num_threads;
+  settings.silhouette_error_diameters = params_.color_search_mesh_error_diameters;
   return std::make_unique<ObjectSearch>(mesh_, settings);
 }
 

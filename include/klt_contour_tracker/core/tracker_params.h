@@ -144,6 +144,11 @@ struct TrackerParams {
   /// the best colour contrast before refinement, are refined (the last good pose and the last
   /// frame's are always): a lost frame refined 23 hypotheses at about 1 ms each.
   int color_search_refined = 0;
+  /// ours (0 = the mesh as given; realtime 0.001): the colour model's silhouettes (learning,
+  /// search, scoring) are drawn from the mesh simplified as far as it stays within this share of
+  /// its diameter (ObjectSearchSettings::silhouette_error_diameters, [0, 0.05]). The refinement
+  /// and everything else keep the full mesh.
+  double color_search_mesh_error_diameters = 0.0;
   /// ours (0 = off: the whole frame; realtime 0.25): the colour search and its hypotheses keep
   /// to a disc around the last good pose's projected centre whose radius grows by this many
   /// object diameters (at the last good depth) per frame since that pose. A hand-held object
