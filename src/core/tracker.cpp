@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "klt_contour_tracker/core/elapsed.h"
+#include "klt_contour_tracker/core/mesh_simplification.h"
 #include "klt_contour_tracker/core/motion_model.h"
 #include "klt_contour_tracker/core/motion_prior_cost.h"
 #include "klt_contour_tracker/core/plausibility.h"
@@ -41,12 +42,32 @@ Tracker::Tracker(std::shared_ptr<const Mesh> mesh, const PinholeCamera& camera,
   keypoints_.set_object_extent(diameter_m_, center_object_);
   set_camera(camera);
   if (params_.refine) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
+  configure_coarse_refiner();
   workers_ = std::make_unique<WorkerThreads>(params_.num_threads);
   configure_motion_model();
   configure_cues();
 }
 
 Tracker::~Tracker() = default;
+
+void Tracker::configure_coarse_refiner() {
+  coarse_refiner_odd_.reset();  // a replica, made again when next needed
+  if (!(params_.refine && params_.hypothesis_mesh_error_diameters > 0.0)) {
+    coarse_refiner_.reset();
+    return;
+  }
+  if (!coarse_mesh_ || coarse_mesh_error_diameters_ != params_.hypothesis_mesh_error_diameters) {
+    coarse_mesh_ = std::make_shared<const Mesh>(
+        simplified_mesh(*mesh_, params_.hypothesis_mesh_error_diameters * diameter_m_));
+    coarse_mesh_error_diameters_ = params_.hypothesis_mesh_error_diameters;
+    coarse_refiner_.reset();
+  }
+  // Built now, not on the first lost frame: its visibility table takes up to a second.
+  if (!coarse_refiner_)
+    coarse_refiner_ = std::make_unique<PoseRefiner>(coarse_mesh_, params_);
+  else
+    coarse_refiner_->set_params(params_);  // rebuilds only what the new parameters change
+}
 
 void Tracker::configure_cues() {
   region_cost_.reset();
@@ -116,6 +137,7 @@ void Tracker::set_params(const TrackerParams& params) {
   if (params_.refine && !refiner_) refiner_ = std::make_unique<PoseRefiner>(mesh_, params_);
   if (refiner_) refiner_->set_params(params_);
   hypothesis_refiner_.reset();  // made again from the refiner when next needed
+  configure_coarse_refiner();
   if (workers_->threads() != params_.num_threads)
     workers_ = std::make_unique<WorkerThreads>(params_.num_threads);
   if (motion_changed) configure_motion_model();
@@ -271,6 +293,16 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
   widened.extrapolated_lateral_bound *= search_scale;
   if (!shift_search) widened.shift_search_diameters = 0.0;
   if (refine) refiner_->set_params(widened);  // only the box changes: nothing is rebuilt
+  // hypothesis_mesh_error_diameters: the hypotheses' contours come from the simplified mesh
+  // (not with added cues: they are the tracking refiner's).
+  const bool coarse = refine && params_.hypothesis_mesh_error_diameters > 0.0 &&
+                      params_.optimizer == "coarse_to_fine" && !refiner_->has_added_cues();
+  PoseRefiner* even_refiner = refine ? refiner_.get() : nullptr;
+  if (coarse) {
+    if (!coarse_refiner_) configure_coarse_refiner();
+    coarse_refiner_->set_params(widened);
+    even_refiner = coarse_refiner_.get();
+  }
   // With two threads and more than one hypothesis, the odd ones are refined on the worker by a
   // replica of the refiner: each refinement depends only on its hypothesis and the frame, so
   // the results do not depend on the thread count.
@@ -290,14 +322,15 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
   };
   try {
     if (parallel) {
-      if (!hypothesis_refiner_) hypothesis_refiner_ = refiner_->replica();
-      hypothesis_refiner_->set_params(widened);
+      std::unique_ptr<PoseRefiner>& odd_refiner = coarse ? coarse_refiner_odd_ : hypothesis_refiner_;
+      if (!odd_refiner) odd_refiner = even_refiner->replica();
+      odd_refiner->set_params(widened);
       WorkerThreads::Pending odd =
-          workers_->start([&]() { refine_every_other(hypothesis_refiner_.get(), 1, 2); });
-      refine_every_other(refiner_.get(), 0, 2);
+          workers_->start([&]() { refine_every_other(odd_refiner.get(), 1, 2); });
+      refine_every_other(even_refiner, 0, 2);
       odd.wait();
     } else {
-      refine_every_other(refine ? refiner_.get() : nullptr, 0, 1);
+      refine_every_other(even_refiner, 0, 1);
     }
   } catch (...) {
     if (refine) refiner_->set_params(params_);

@@ -129,7 +129,7 @@ TEST(TrackerParams, SetParamParsesEachType) {
 
 TEST(TrackerParams, DescribeListsEveryFieldOnce) {
   const auto fields = describe(TrackerParams{});
-  EXPECT_EQ(fields.size(), 114u);
+  EXPECT_EQ(fields.size(), 115u);
   EXPECT_EQ(fields.front().first, "max_keypoints");
 }
 
@@ -175,6 +175,11 @@ TEST(TrackerParams, RealtimePresetIsValidAndPaperIsTheDefaults) {
   EXPECT_THROW(bad.validate(), std::invalid_argument);
   EXPECT_DOUBLE_EQ(realtime.color_search_mesh_error_diameters, 0.001);
   EXPECT_EQ(TrackerParams{}.color_search_mesh_error_diameters, 0.0);  // the mesh as given
+  bad = realtime;
+  bad.hypothesis_mesh_error_diameters = 0.06;  // [0, 0.05]
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  EXPECT_DOUBLE_EQ(realtime.hypothesis_mesh_error_diameters, 0.001);
+  EXPECT_EQ(TrackerParams{}.hypothesis_mesh_error_diameters, 0.0);
   bad = realtime;
   bad.relocalization_interval_frames = 0;
   EXPECT_THROW(bad.validate(), std::invalid_argument);

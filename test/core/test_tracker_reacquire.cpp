@@ -2,6 +2,11 @@
 // keypoint tracking resumes from the result. A coarse visibility table keeps the test quick.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
+#include <utility>
+#include <vector>
+
 #include "klt_contour_tracker/core/tracker.h"
 #include "synthetic_scene.h"
 
@@ -78,6 +83,98 @@ TEST(TrackerReacquire, HypothesesOnTwoThreadsGiveTheOneThreadResults) {
     }
     // The refinement did its work: the hypotheses closest to the truth end within 3 mm.
     EXPECT_LT(translation_error(two[1].object_to_camera, truth), 0.003);
+  }
+}
+
+/// `mesh` with every triangle split in four (midpoints shared between neighbours), `times`
+/// times: the same surface with 4^times as many faces, as a scan has.
+Mesh subdivided(Mesh mesh, int times) {
+  for (int t = 0; t < times; ++t) {
+    std::map<std::pair<int, int>, int> midpoint;
+    const auto middle = [&](int a, int b) {
+      const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+      const auto found = midpoint.find(key);
+      if (found != midpoint.end()) return found->second;
+      mesh.vertices.push_back(0.5 * (mesh.vertices[a] + mesh.vertices[b]));
+      return midpoint[key] = static_cast<int>(mesh.vertices.size()) - 1;
+    };
+    std::vector<Eigen::Vector3i> faces;
+    for (const Eigen::Vector3i& f : mesh.faces) {
+      const int ab = middle(f[0], f[1]), bc = middle(f[1], f[2]), ca = middle(f[2], f[0]);
+      faces.emplace_back(f[0], ab, ca);
+      faces.emplace_back(ab, f[1], bc);
+      faces.emplace_back(ca, bc, f[2]);
+      faces.emplace_back(ab, bc, ca);
+    }
+    mesh.faces = faces;
+  }
+  mesh.corner_uvs.clear();
+  mesh.texture.release();
+  return mesh;
+}
+
+/// hypothesis_mesh_error_diameters: the hypotheses of a dense mesh refined on its simplified
+/// copy end where the full mesh's do, on one thread or two.
+TEST(TrackerReacquire, HypothesesOnTheSimplifiedMeshEndWhereTheFullMeshsDo) {
+  const auto box = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  const auto dense = std::make_shared<const Mesh>(subdivided(*box, 4));  // 3072 faces
+  ASSERT_EQ(dense->faces.size(), 12u * 256);
+  Renderer renderer(box);
+  const PinholeCamera camera = test::make_camera();
+  const Pose truth = test::make_pose(0.45);
+  const cv::Mat frame = test::render_frame(renderer, camera, truth,
+                                           test::make_background(camera.size(), 5), 1.0, 1);
+  // Four hypotheses within the refinement's reach: up to 3 deg and 7 mm off.
+  std::vector<Pose> around;
+  for (int k = 0; k < 4; ++k)
+    around.push_back(test::move(truth, 1.0 * k, {0.3, 1.0, 0.2}, {0.002 * k, -0.001 * k, 0.0}));
+  TrackerParams params = make_preset("realtime");
+  params.icosphere_subdivisions = 2;
+  params.visibility_resolution_px = 256;
+  params.hypothesis_mesh_error_diameters = 0.0;
+  Tracker full(dense, camera, params);
+  params.hypothesis_mesh_error_diameters = 0.001;
+  Tracker coarse(dense, camera, params);
+  params.num_threads = 1;
+  Tracker coarse_serial(dense, camera, params);
+  const std::vector<TrackResult> a = full.refine_hypotheses({frame, 0.1}, around, 1.0, true);
+  const std::vector<TrackResult> b = coarse.refine_hypotheses({frame, 0.1}, around, 1.0, true);
+  const std::vector<TrackResult> c = coarse_serial.refine_hypotheses({frame, 0.1}, around, 1.0, true);
+  ASSERT_EQ(b.size(), around.size());
+  int compared = 0;
+  for (std::size_t i = 0; i < around.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_TRUE(b[i].refined);
+    // Where the full mesh's refinement converged (3 mm / 1 deg), the simplified one ends within
+    // 1 mm / 0.5 deg of it: the flat faces collapse to the box's 12 triangles, whose outline is
+    // the same. (From 3 deg / 7 mm the dense mesh's refinement stops 5 deg off here and the
+    // simplified one's converges: its visibility table at 256 px misses none of its faces.)
+    if (translation_error(a[i].object_to_camera, truth) < 0.003 &&
+        rotation_error_deg(a[i].object_to_camera, truth) < 1.0) {
+      ++compared;
+      EXPECT_LT(translation_error(a[i].object_to_camera, b[i].object_to_camera), 0.001);
+      EXPECT_LT(rotation_error_deg(a[i].object_to_camera, b[i].object_to_camera), 0.5);
+    }
+    // The second thread's refiner is a replica of the simplified mesh's: bit for bit.
+    EXPECT_EQ((b[i].object_to_camera.matrix() - c[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(), 0.0);
+  }
+  EXPECT_GE(compared, 2);
+  for (std::size_t i = 0; i < around.size(); ++i) {
+    EXPECT_LT(translation_error(b[i].object_to_camera, truth), 0.003) << i;
+    EXPECT_LT(rotation_error_deg(b[i].object_to_camera, truth), 1.0) << i;
+  }
+
+  // Switched off and on again at run time: the full mesh's results, then the same again.
+  params = coarse.params();
+  params.hypothesis_mesh_error_diameters = 0.0;
+  coarse.set_params(params);
+  const std::vector<TrackResult> off = coarse.refine_hypotheses({frame, 0.1}, around, 1.0, true);
+  params.hypothesis_mesh_error_diameters = 0.001;
+  coarse.set_params(params);
+  const std::vector<TrackResult> on = coarse.refine_hypotheses({frame, 0.1}, around, 1.0, true);
+  for (std::size_t i = 0; i < around.size(); ++i) {
+    EXPECT_EQ((off[i].object_to_camera.matrix() - a[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ((on[i].object_to_camera.matrix() - b[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(), 0.0);
   }
 }
 

@@ -148,6 +148,8 @@ class Tracker {
   cv::Mat to_bgr(const cv::Mat& image) const;
   /// Pose expected in the next frame: the motion model's prediction, else the last pose.
   Pose predicted_pose() const;
+  /// (Re)makes the simplified mesh's refiner for hypothesis_mesh_error_diameters (none at 0).
+  void configure_coarse_refiner();
 
   std::shared_ptr<const Mesh> mesh_;
   PinholeCamera camera_;
@@ -156,6 +158,11 @@ class Tracker {
   std::unique_ptr<PoseRefiner> refiner_;
   /// refine_hypotheses()' second thread's refiner (a replica of refiner_), made when needed.
   std::unique_ptr<PoseRefiner> hypothesis_refiner_;
+  /// hypothesis_mesh_error_diameters > 0: the mesh simplified within it (and that error) and the
+  /// two refiners of the hypotheses on it, made when first needed.
+  std::shared_ptr<const Mesh> coarse_mesh_;
+  double coarse_mesh_error_diameters_ = 0.0;
+  std::unique_ptr<PoseRefiner> coarse_refiner_, coarse_refiner_odd_;
   std::unique_ptr<MotionModel> motion_;  ///< null unless params_.motion_model
   std::shared_ptr<RegionCost> region_cost_;       ///< null unless region_weight > 0
   std::shared_ptr<MotionPriorCost> motion_prior_;  ///< null unless motion_prior_weight > 0
