@@ -159,7 +159,8 @@ class Tracker {
   /// refine_hypotheses()' second thread's refiner (a replica of refiner_), made when needed.
   std::unique_ptr<PoseRefiner> hypothesis_refiner_;
   /// hypothesis_mesh_error_diameters > 0: the mesh simplified within it (and that error) and the
-  /// two refiners of the hypotheses on it, made when first needed.
+  /// hypotheses' refiner on it, built at start and on set_params() (configure_coarse_refiner());
+  /// the second thread's replica of it when first needed.
   std::shared_ptr<const Mesh> coarse_mesh_;
   double coarse_mesh_error_diameters_ = 0.0;
   std::unique_ptr<PoseRefiner> coarse_refiner_, coarse_refiner_odd_;
