@@ -60,8 +60,8 @@ Mesh make_grid(double side_m, int n) {
 /// Pixels where the two silhouettes differ that are farther than `tolerance_px` from the
 /// first one's outline.
 int differences_off_the_outline(const cv::Mat& a, const cv::Mat& b, int tolerance_px) {
-  const cv::Mat kernel =
-      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * tolerance_px + 1, 2 * tolerance_px + 1));
+  const cv::Mat kernel = cv::getStructuringElement(
+      cv::MORPH_RECT, cv::Size(2 * tolerance_px + 1, 2 * tolerance_px + 1));
   cv::Mat grown, shrunk, band, differ;
   cv::dilate(a, grown, kernel);
   cv::erode(a, shrunk, kernel);
@@ -85,7 +85,8 @@ void expect_same_silhouette(const Mesh& original, const Mesh& simplified, double
     // Along the outline they differ by a fraction of a pixel: few pixels flip.
     cv::Mat differ;
     cv::bitwise_xor(a, b, differ);
-    EXPECT_LT(cv::countNonZero(differ), 0.02 * cv::countNonZero(a)) << "angles " << angles_deg.transpose();
+    EXPECT_LT(cv::countNonZero(differ), 0.02 * cv::countNonZero(a))
+        << "angles " << angles_deg.transpose();
   }
 }
 
@@ -108,8 +109,9 @@ TEST(MeshSimplification, ADenseSphereLosesMostFacesAndKeepsItsSilhouette) {
   // Faces still face outwards (CCW from outside).
   for (int f = 0; f < static_cast<int>(simplified.faces.size()); ++f) {
     const Eigen::Vector3i& face = simplified.faces[f];
-    const Eigen::Vector3d centre =
-        (simplified.vertices[face[0]] + simplified.vertices[face[1]] + simplified.vertices[face[2]]) / 3;
+    const Eigen::Vector3d centre = (simplified.vertices[face[0]] + simplified.vertices[face[1]] +
+                                    simplified.vertices[face[2]]) /
+                                   3;
     EXPECT_GT(simplified.face_normal(f).dot(centre), 0.0) << "face " << f;
   }
   expect_same_silhouette(sphere, simplified, 0.3);
@@ -124,9 +126,12 @@ TEST(MeshSimplification, FlatFacesCollapseAndTheOutlineStays) {
       const Mesh grid = make_grid(side, 24);
       Eigen::Matrix3d rotation;
       // Maps the grid's +z normal onto sign * axis, keeping the rotation proper.
-      if (axis == 2) rotation = Eigen::AngleAxisd(sign > 0 ? 0.0 : M_PI, Eigen::Vector3d::UnitX());
-      else if (axis == 0) rotation = Eigen::AngleAxisd(sign * M_PI / 2, Eigen::Vector3d::UnitY());
-      else rotation = Eigen::AngleAxisd(-sign * M_PI / 2, Eigen::Vector3d::UnitX());
+      if (axis == 2)
+        rotation = Eigen::AngleAxisd(sign > 0 ? 0.0 : M_PI, Eigen::Vector3d::UnitX());
+      else if (axis == 0)
+        rotation = Eigen::AngleAxisd(sign * M_PI / 2, Eigen::Vector3d::UnitY());
+      else
+        rotation = Eigen::AngleAxisd(-sign * M_PI / 2, Eigen::Vector3d::UnitX());
       Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
       transform.linear() = rotation;
       transform.translation() = rotation * Eigen::Vector3d(0, 0, side / 2);
@@ -169,8 +174,10 @@ TEST(MeshSimplification, ZeroErrorCopiesTheGeometryWithoutTheTexture) {
 TEST(MeshSimplification, BadInputIsRefused) {
   const Mesh box = test::make_box(0.08, 0.06, 0.05, false);
   EXPECT_THROW(simplified_mesh(box, -0.001), std::invalid_argument);
-  EXPECT_THROW(simplified_mesh(box, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
-  EXPECT_THROW(simplified_mesh(box, std::numeric_limits<double>::infinity()), std::invalid_argument);
+  EXPECT_THROW(simplified_mesh(box, std::numeric_limits<double>::quiet_NaN()),
+               std::invalid_argument);
+  EXPECT_THROW(simplified_mesh(box, std::numeric_limits<double>::infinity()),
+               std::invalid_argument);
   Mesh broken = box;
   broken.faces.front() = Eigen::Vector3i(0, 1, static_cast<int>(box.vertices.size()));
   EXPECT_THROW(simplified_mesh(broken, 0.001), std::invalid_argument);
@@ -193,19 +200,24 @@ TEST(MeshSimplification, TheColourSearchScoresTheSameOnTheSimplifiedMesh) {
   ObjectSearch full(mesh), simplified(mesh, simplified_settings);
   ASSERT_TRUE(full.learn(frame, truth, camera));
   ASSERT_TRUE(simplified.learn(frame, truth, camera));
-  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.02, 0, 0),
-                                       Eigen::Vector3d(0, -0.04, 0.03), Eigen::Vector3d(0.15, 0, 0)}) {
+  for (const Eigen::Vector3d& shift :
+       {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.02, 0, 0), Eigen::Vector3d(0, -0.04, 0.03),
+        Eigen::Vector3d(0.15, 0, 0)}) {
     const Pose pose = test::move(truth, 0, Eigen::Vector3d::UnitZ(), shift);
-    EXPECT_NEAR(full.score(frame, pose, camera).contrast, simplified.score(frame, pose, camera).contrast,
-                0.005)
+    EXPECT_NEAR(full.score(frame, pose, camera).contrast,
+                simplified.score(frame, pose, camera).contrast, 0.005)
         << "shift " << shift.transpose();
   }
   // The search finds the sphere where the full mesh's search does.
-  const std::vector<SearchCandidate> a = full.search(frame, test::move(truth, 0, Eigen::Vector3d::UnitZ(), {0.03, 0.02, 0}), camera);
-  const std::vector<SearchCandidate> b = simplified.search(frame, test::move(truth, 0, Eigen::Vector3d::UnitZ(), {0.03, 0.02, 0}), camera);
+  const std::vector<SearchCandidate> a =
+      full.search(frame, test::move(truth, 0, Eigen::Vector3d::UnitZ(), {0.03, 0.02, 0}), camera);
+  const std::vector<SearchCandidate> b = simplified.search(
+      frame, test::move(truth, 0, Eigen::Vector3d::UnitZ(), {0.03, 0.02, 0}), camera);
   ASSERT_FALSE(a.empty());
   ASSERT_FALSE(b.empty());
-  EXPECT_LT((a.front().object_to_camera.translation() - b.front().object_to_camera.translation()).norm(), 0.005);
+  EXPECT_LT(
+      (a.front().object_to_camera.translation() - b.front().object_to_camera.translation()).norm(),
+      0.005);
   EXPECT_LT((b.front().object_to_camera.translation() - truth.translation()).norm(), 0.02);
 
   ObjectSearchSettings bad;

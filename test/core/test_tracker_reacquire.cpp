@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -13,12 +14,14 @@
 namespace kct {
 namespace {
 
-TrackerParams quick_paper() {
-  TrackerParams params = make_preset("paper");
+TrackerParams quick(const std::string& preset, int visibility_resolution_px = 128) {
+  TrackerParams params = make_preset(preset);
   params.icosphere_subdivisions = 2;
-  params.visibility_resolution_px = 128;
+  params.visibility_resolution_px = visibility_resolution_px;
   return params;
 }
+
+TrackerParams quick_paper() { return quick("paper"); }
 
 TEST(TrackerReacquire, RecoversAnOffsetPoseAndKeypointTrackingResumes) {
   auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
@@ -49,40 +52,50 @@ TEST(TrackerReacquire, RecoversAnOffsetPoseAndKeypointTrackingResumes) {
   EXPECT_LT(rotation_error_deg(tracked.object_to_camera, next), 2.0);
 }
 
-TEST(TrackerReacquire, HypothesesOnTwoThreadsGiveTheOneThreadResults) {
-  auto mesh = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
-  Renderer renderer(mesh);
-  const PinholeCamera camera = test::make_camera();
-  const Pose truth = test::make_pose(0.45);
-  const cv::Mat frame = test::render_frame(renderer, camera, truth,
-                                           test::make_background(camera.size(), 5), 1.0, 1);
-  // Five hypotheses around the truth (an odd count: the threads get 3 and 2).
+/// The 12 x 8 x 6 cm box at make_pose(0.45) over a textured background and `count` hypotheses
+/// around it, the k-th turned by k x step_deg and moved by k x step_m.
+struct HypothesisScene {
+  std::shared_ptr<const Mesh> box = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
+  PinholeCamera camera = test::make_camera();
+  Pose truth = test::make_pose(0.45);
+  cv::Mat frame;
   std::vector<Pose> around;
-  for (int k = 0; k < 5; ++k)
-    around.push_back(test::move(truth, 2.0 * k, {0.3, 1.0, 0.2}, {0.004 * k, -0.002 * k, 0.0}));
-  TrackerParams params = make_preset("realtime");
-  params.icosphere_subdivisions = 2;
-  params.visibility_resolution_px = 128;
+  HypothesisScene(int count, double step_deg, const Eigen::Vector3d& step_m) {
+    frame = test::render_frame(Renderer(box), camera, truth,
+                               test::make_background(camera.size(), 5), 1.0, 1);
+    for (int k = 0; k < count; ++k)
+      around.push_back(test::move(truth, step_deg * k, {0.3, 1.0, 0.2}, step_m * k));
+  }
+};
+
+TEST(TrackerReacquire, HypothesesOnTwoThreadsGiveTheOneThreadResults) {
+  // Five hypotheses around the truth (an odd count: the threads get 3 and 2).
+  const HypothesisScene scene(5, 2.0, {0.004, -0.002, 0.0});
+  TrackerParams params = quick("realtime");
   params.num_threads = 1;
-  Tracker serial(mesh, camera, params);
+  Tracker serial(scene.box, scene.camera, params);
   params.num_threads = 2;
-  Tracker parallel(mesh, camera, params);
+  Tracker parallel(scene.box, scene.camera, params);
   for (const bool shift_search : {true, false}) {
-    const std::vector<TrackResult> one = serial.refine_hypotheses({frame, 0.1}, around, 1.0, shift_search);
-    const std::vector<TrackResult> two = parallel.refine_hypotheses({frame, 0.1}, around, 1.0, shift_search);
-    ASSERT_EQ(one.size(), around.size());
-    ASSERT_EQ(two.size(), around.size());
-    for (std::size_t i = 0; i < around.size(); ++i) {
+    const std::vector<TrackResult> one =
+        serial.refine_hypotheses({scene.frame, 0.1}, scene.around, 1.0, shift_search);
+    const std::vector<TrackResult> two =
+        parallel.refine_hypotheses({scene.frame, 0.1}, scene.around, 1.0, shift_search);
+    ASSERT_EQ(one.size(), scene.around.size());
+    ASSERT_EQ(two.size(), scene.around.size());
+    for (std::size_t i = 0; i < scene.around.size(); ++i) {
       SCOPED_TRACE(i);
       EXPECT_TRUE(one[i].refined);
       EXPECT_EQ(two[i].status, TrackStatus::kReacquired);
       // Bit for bit: each refinement depends only on its hypothesis and the frame.
-      EXPECT_EQ((one[i].object_to_camera.matrix() - two[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(),
+      EXPECT_EQ((one[i].object_to_camera.matrix() - two[i].object_to_camera.matrix())
+                    .cwiseAbs()
+                    .maxCoeff(),
                 0.0);
       EXPECT_EQ(one[i].energy_after, two[i].energy_after);
     }
     // The refinement did its work: the hypotheses closest to the truth end within 3 mm.
-    EXPECT_LT(translation_error(two[1].object_to_camera, truth), 0.003);
+    EXPECT_LT(translation_error(two[1].object_to_camera, scene.truth), 0.003);
   }
 }
 
@@ -116,65 +129,66 @@ Mesh subdivided(Mesh mesh, int times) {
 /// hypothesis_mesh_error_diameters: the hypotheses of a dense mesh refined on its simplified
 /// copy end where the full mesh's do, on one thread or two.
 TEST(TrackerReacquire, HypothesesOnTheSimplifiedMeshEndWhereTheFullMeshsDo) {
-  const auto box = std::make_shared<Mesh>(test::make_box(0.12, 0.08, 0.06));
-  const auto dense = std::make_shared<const Mesh>(subdivided(*box, 4));  // 3072 faces
-  ASSERT_EQ(dense->faces.size(), 12u * 256);
-  Renderer renderer(box);
-  const PinholeCamera camera = test::make_camera();
-  const Pose truth = test::make_pose(0.45);
-  const cv::Mat frame = test::render_frame(renderer, camera, truth,
-                                           test::make_background(camera.size(), 5), 1.0, 1);
   // Four hypotheses within the refinement's reach: up to 3 deg and 7 mm off.
-  std::vector<Pose> around;
-  for (int k = 0; k < 4; ++k)
-    around.push_back(test::move(truth, 1.0 * k, {0.3, 1.0, 0.2}, {0.002 * k, -0.001 * k, 0.0}));
-  TrackerParams params = make_preset("realtime");
-  params.icosphere_subdivisions = 2;
-  params.visibility_resolution_px = 256;
+  const HypothesisScene scene(4, 1.0, {0.002, -0.001, 0.0});
+  const auto dense = std::make_shared<const Mesh>(subdivided(*scene.box, 4));  // 3072 faces
+  ASSERT_EQ(dense->faces.size(), 12u * 256);
+  TrackerParams params = quick("realtime", 256);
   params.hypothesis_mesh_error_diameters = 0.0;
-  Tracker full(dense, camera, params);
+  Tracker full(dense, scene.camera, params);
   params.hypothesis_mesh_error_diameters = 0.001;
-  Tracker coarse(dense, camera, params);
+  Tracker coarse(dense, scene.camera, params);
   params.num_threads = 1;
-  Tracker coarse_serial(dense, camera, params);
-  const std::vector<TrackResult> a = full.refine_hypotheses({frame, 0.1}, around, 1.0, true);
-  const std::vector<TrackResult> b = coarse.refine_hypotheses({frame, 0.1}, around, 1.0, true);
-  const std::vector<TrackResult> c = coarse_serial.refine_hypotheses({frame, 0.1}, around, 1.0, true);
-  ASSERT_EQ(b.size(), around.size());
+  Tracker coarse_serial(dense, scene.camera, params);
+  const std::vector<TrackResult> a =
+      full.refine_hypotheses({scene.frame, 0.1}, scene.around, 1.0, true);
+  const std::vector<TrackResult> b =
+      coarse.refine_hypotheses({scene.frame, 0.1}, scene.around, 1.0, true);
+  const std::vector<TrackResult> c =
+      coarse_serial.refine_hypotheses({scene.frame, 0.1}, scene.around, 1.0, true);
+  ASSERT_EQ(b.size(), scene.around.size());
   int compared = 0;
-  for (std::size_t i = 0; i < around.size(); ++i) {
+  for (std::size_t i = 0; i < scene.around.size(); ++i) {
     SCOPED_TRACE(i);
     EXPECT_TRUE(b[i].refined);
     // Where the full mesh's refinement converged (3 mm / 1 deg), the simplified one ends within
     // 1 mm / 0.5 deg of it: the flat faces collapse to the box's 12 triangles, whose outline is
     // the same. (From 3 deg / 7 mm the dense mesh's refinement stops 5 deg off here and the
     // simplified one's converges: its visibility table at 256 px misses none of its faces.)
-    if (translation_error(a[i].object_to_camera, truth) < 0.003 &&
-        rotation_error_deg(a[i].object_to_camera, truth) < 1.0) {
+    if (translation_error(a[i].object_to_camera, scene.truth) < 0.003 &&
+        rotation_error_deg(a[i].object_to_camera, scene.truth) < 1.0) {
       ++compared;
       EXPECT_LT(translation_error(a[i].object_to_camera, b[i].object_to_camera), 0.001);
       EXPECT_LT(rotation_error_deg(a[i].object_to_camera, b[i].object_to_camera), 0.5);
     }
     // The second thread's refiner is a replica of the simplified mesh's: bit for bit.
-    EXPECT_EQ((b[i].object_to_camera.matrix() - c[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ(
+        (b[i].object_to_camera.matrix() - c[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(),
+        0.0);
   }
   EXPECT_GE(compared, 2);
-  for (std::size_t i = 0; i < around.size(); ++i) {
-    EXPECT_LT(translation_error(b[i].object_to_camera, truth), 0.003) << i;
-    EXPECT_LT(rotation_error_deg(b[i].object_to_camera, truth), 1.0) << i;
+  for (std::size_t i = 0; i < scene.around.size(); ++i) {
+    EXPECT_LT(translation_error(b[i].object_to_camera, scene.truth), 0.003) << i;
+    EXPECT_LT(rotation_error_deg(b[i].object_to_camera, scene.truth), 1.0) << i;
   }
 
   // Switched off and on again at run time: the full mesh's results, then the same again.
   params = coarse.params();
   params.hypothesis_mesh_error_diameters = 0.0;
   coarse.set_params(params);
-  const std::vector<TrackResult> off = coarse.refine_hypotheses({frame, 0.1}, around, 1.0, true);
+  const std::vector<TrackResult> off =
+      coarse.refine_hypotheses({scene.frame, 0.1}, scene.around, 1.0, true);
   params.hypothesis_mesh_error_diameters = 0.001;
   coarse.set_params(params);
-  const std::vector<TrackResult> on = coarse.refine_hypotheses({frame, 0.1}, around, 1.0, true);
-  for (std::size_t i = 0; i < around.size(); ++i) {
-    EXPECT_EQ((off[i].object_to_camera.matrix() - a[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(), 0.0);
-    EXPECT_EQ((on[i].object_to_camera.matrix() - b[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(), 0.0);
+  const std::vector<TrackResult> on =
+      coarse.refine_hypotheses({scene.frame, 0.1}, scene.around, 1.0, true);
+  for (std::size_t i = 0; i < scene.around.size(); ++i) {
+    EXPECT_EQ(
+        (off[i].object_to_camera.matrix() - a[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(),
+        0.0);
+    EXPECT_EQ(
+        (on[i].object_to_camera.matrix() - b[i].object_to_camera.matrix()).cwiseAbs().maxCoeff(),
+        0.0);
   }
 }
 
