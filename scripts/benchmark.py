@@ -446,7 +446,7 @@ def header_lines(title, args, start, duration_s, gen_s, load_start, load_end, ex
         load_start, load_end, os.cpu_count(),
         " The CPU was shared with other jobs: frame times are noisy and pessimistic." if busy else ""))
     if args.reuse:
-        section = title.split()[0].lower().replace("opt-style", "opt")
+        section = title.split()[0].lower().replace("opt-style", "opt").replace("large-mesh", "large")
         origins = []
         for label in args.reuse:
             code = os.path.join(args.data_results, section, label, "CODE")
@@ -1457,7 +1457,11 @@ def run_hard(args, configs, runner, data, docs_dir, tmp, set_name="hard", folder
     L.append("Median of the per-sequence median `track()` time per frame (first frame excluded), ms.\n")
     L += speed_table(rows, configs, [(o, sel(object=o)) for o in objects])
     L.append("")
-    L += tail_table(rows, [c for c in configs if c[0] in DEFAULT_PRESETS], [(o, sel(object=o)) for o in objects])
+    # The slow frames of the default presets and of the variants asked for on the command line
+    # (--variant: e.g. the large-mesh section's full mesh), not of every built-in variant.
+    asked = {v[0] for v in args.variant}
+    L += tail_table(rows, [c for c in configs if c[0] in DEFAULT_PRESETS or c[0] in asked],
+                    [(o, sel(object=o)) for o in objects])
     L += stage_table(rows, configs, [(o, sel(object=o)) for o in objects])
     for name in os.listdir(docs_dir):
         if name.startswith(set_name + "_") and name.endswith(".png"):
