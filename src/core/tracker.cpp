@@ -298,8 +298,7 @@ std::vector<TrackResult> Tracker::refine_hypotheses(const Frame& frame,
   const bool coarse = refine && params_.hypothesis_mesh_error_diameters > 0.0 &&
                       params_.optimizer == "coarse_to_fine" && !refiner_->has_added_cues();
   PoseRefiner* even_refiner = refine ? refiner_.get() : nullptr;
-  if (coarse) {
-    if (!coarse_refiner_) configure_coarse_refiner();
+  if (coarse) {  // coarse_refiner_ exists: configure_coarse_refiner() made it with params_
     coarse_refiner_->set_params(widened);
     even_refiner = coarse_refiner_.get();
   }

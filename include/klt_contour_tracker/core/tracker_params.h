@@ -150,9 +150,8 @@ struct TrackerParams {
   /// and everything else keep the full mesh.
   double color_search_mesh_error_diameters = 0.0;
   /// ours (0 = the mesh as given; realtime 0.001): the hypotheses of a re-acquisition or of a
-  /// check (the colour
-  /// search's placements, the turns of rotation_check and texture_check, Tracker::
-  /// refine_hypotheses()) are refined on the mesh simplified within this share of its
+  /// check (the colour search's placements, the turns of rotation_check and texture_check:
+  /// Tracker::refine_hypotheses()) are refined on the mesh simplified within this share of its
   /// diameter, [0, 0.05]; the tracked frame's refinement keeps the full mesh.
   double hypothesis_mesh_error_diameters = 0.0;
   /// ours (0 = off: the whole frame; realtime 0.25): the colour search and its hypotheses keep
