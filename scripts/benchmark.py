@@ -446,7 +446,10 @@ def header_lines(title, args, start, duration_s, gen_s, load_start, load_end, ex
         load_start, load_end, os.cpu_count(),
         " The CPU was shared with other jobs: frame times are noisy and pessimistic." if busy else ""))
     if args.reuse:
-        section = title.split()[0].lower().replace("opt-style", "opt").replace("large-mesh", "large")
+        # The results folder of the section: its key in SECTION_TITLES (hard2, camera, large...),
+        # else the title's first word (noise, real, slow, OPT-style).
+        section = {v: k for k, v in SECTION_TITLES.items()}.get(title) or \
+            title.split()[0].lower().replace("opt-style", "opt")
         origins = []
         for label in args.reuse:
             code = os.path.join(args.data_results, section, label, "CODE")
